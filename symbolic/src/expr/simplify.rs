@@ -63,10 +63,13 @@ impl ExprArena {
             let over = self.sums_rewritten(one, Self::over_common_denominator);
             candidates.extend([one, over]);
         }
-        let length =
-            |arena: &ExprArena, x: ExprId| Printer::for_display(arena, Syntax::Text).print(x).len();
+        // Pairing shortens some sums and lengthens others: taken sum by sum where it pays.
+        let paired = self.sums_shortened(collected, Self::factored_pairs);
+        let over = self.sums_shortened(paired, Self::over_common_denominator);
+        let square = self.sums_rewritten(expanded, Self::perfect_squares);
+        candidates.extend([paired, over, square]);
         candidates.into_iter().fold(e, |best, x| {
-            if length(self, x) < length(self, best) {
+            if printed_length(self, x) < printed_length(self, best) {
                 x
             } else {
                 best
@@ -74,14 +77,39 @@ impl ExprArena {
         })
     }
 
+    /// [`Self::sums_rewritten`] keeping, at each sum, the shorter to print of the sum as it is
+    /// and as `rule` writes it: a rule that shortens one sum of an expression and lengthens
+    /// another (`(m₁ + 3 m₂)/6` against `m₁/6 + m₂/2`) is taken where it pays.
+    fn sums_shortened(&mut self, e: ExprId, rule: fn(&mut Self, &[ExprId]) -> ExprId) -> ExprId {
+        self.sums_walk(e, rule, true)
+    }
+
     /// `e` rebuilt bottom up (memoised) with each sum of (rebuilt) terms made by `rule`, and
     /// every other node by the canonical constructors: the walk the printing forms share.
     fn sums_rewritten(&mut self, e: ExprId, rule: fn(&mut Self, &[ExprId]) -> ExprId) -> ExprId {
+        self.sums_walk(e, rule, false)
+    }
+
+    /// The walk of [`Self::sums_rewritten`] and [`Self::sums_shortened`].
+    fn sums_walk(
+        &mut self,
+        e: ExprId,
+        rule: fn(&mut Self, &[ExprId]) -> ExprId,
+        shortest: bool,
+    ) -> ExprId {
         let mut memo: FxHashMap<ExprId, ExprId> = FxHashMap::default();
         for x in self.reachable(&[e]) {
             let node = self.node(x).clone();
             let children: Vec<ExprId> = node.children().iter().map(|c| memo[c]).collect();
             let out = match node {
+                Node::Add(_) if shortest => {
+                    let plain = self.sum(&children);
+                    let ruled = rule(self, &children);
+                    match printed_length(self, ruled) <= printed_length(self, plain) {
+                        true => ruled,
+                        false => plain,
+                    }
+                }
                 Node::Add(_) => rule(self, &children),
                 Node::Mul(_) => self.product(&children),
                 Node::Pow(_) => self.pow(children[0], children[1]),
@@ -218,6 +246,249 @@ impl ExprArena {
         out.extend((0..terms.len()).filter(|&i| !used[i]).map(|i| terms[i]));
         self.sum(&out)
     }
+}
+
+impl ExprArena {
+    /// The sum of `terms` with every three `k A²`, `k β² B²` and `±2 k β A B` (monomials:
+    /// numbers times integer powers) written `k (A ± β B)²`: a kinetic energy
+    /// `m (ẋ² + 2 v ẋ cos ωt + v² cos² ωt)/2` as `m (ẋ + v cos ωt)²/2`. A third term is found
+    /// by `(±2 k β A B)² = 4 (k A²)(k β² B²)`, its sign by comparing it with `2 k β A B`;
+    /// sums of more than `MOST_SQUARED_TERMS` terms are left as they are.
+    fn perfect_squares(&mut self, terms: &[ExprId]) -> ExprId {
+        const MOST_SQUARED_TERMS: usize = 12;
+        if terms.len() < 3 || terms.len() > MOST_SQUARED_TERMS {
+            return self.sum(terms);
+        }
+        let mut used = vec![false; terms.len()];
+        let mut out = Vec::with_capacity(terms.len());
+        for i in 0..terms.len() {
+            for j in i + 1..terms.len() {
+                if used[i] || used[j] {
+                    continue;
+                }
+                let Some((k, a, b)) = self.square_roots(terms[i], terms[j]) else {
+                    continue;
+                };
+                let two = self.int(2);
+                let cross = self.product(&[two, k, a, b]);
+                let minus = self.neg(cross);
+                let Some((l, sign)) = (0..terms.len())
+                    .filter(|&l| l != i && l != j && !used[l])
+                    .find_map(|l| match terms[l] {
+                        t if t == cross => Some((l, false)),
+                        t if t == minus => Some((l, true)),
+                        _ => None,
+                    })
+                else {
+                    continue;
+                };
+                used[i] = true;
+                used[j] = true;
+                used[l] = true;
+                let b = if sign { self.neg(b) } else { b };
+                let base = self.plus(a, b);
+                let square = self.pow(base, two);
+                out.push(self.times(k, square));
+            }
+        }
+        out.extend((0..terms.len()).filter(|&i| !used[i]).map(|i| terms[i]));
+        self.sum(&out)
+    }
+
+    /// `(k, A, β B)` with `p = k A²` and `q = k β² B²`: `k` the coefficient of `p` times the
+    /// lower power of each factor the two share, `β` the rational square root of their
+    /// coefficients' ratio; `None` where there is none (a float coefficient, a power that is
+    /// not an integer, exponents of unlike parity, a ratio that is no square).
+    fn square_roots(&mut self, p: ExprId, q: ExprId) -> Option<(ExprId, ExprId, ExprId)> {
+        let (cp, fp) = self.monomial(p)?;
+        let (cq, fq) = self.monomial(q)?;
+        let (Constant::Rational { num: np, den: dp }, Constant::Rational { num: nq, den: dq }) =
+            (cp, cq)
+        else {
+            return None;
+        };
+        // β² = cq/cp = (nq dp)/(dq np), a square of a rational.
+        let num = nq.checked_mul(dp)?;
+        let den = dq.checked_mul(np)?;
+        let ratio = Constant::rational(num, den)?;
+        let Constant::Rational { num, den } = ratio else {
+            return None;
+        };
+        let beta = Constant::rational(integer_sqrt(num)?, integer_sqrt(den)?)?;
+        let mut bases: Vec<ExprId> = fp.iter().chain(&fq).map(|(b, _)| *b).collect();
+        bases.sort_unstable();
+        bases.dedup();
+        let exponent = |list: &[(ExprId, i64)], b: ExprId| {
+            list.iter().find(|(x, _)| *x == b).map_or(0, |(_, e)| *e)
+        };
+        let (mut k, mut a, mut bb) = (
+            vec![self.constant(cp)],
+            Vec::new(),
+            vec![self.constant(beta)],
+        );
+        for b in bases {
+            let (ep, eq) = (exponent(&fp, b), exponent(&fq, b));
+            if (ep - eq) % 2 != 0 {
+                return None;
+            }
+            let low = ep.min(eq);
+            for (list, e) in [
+                (&mut k, low),
+                (&mut a, (ep - low) / 2),
+                (&mut bb, (eq - low) / 2),
+            ] {
+                if e != 0 {
+                    let e = self.int(e);
+                    list.push(self.pow(b, e));
+                }
+            }
+        }
+        if a.is_empty() && bb.len() == 1 {
+            return None;
+        }
+        Some((self.product(&k), self.product(&a), self.product(&bb)))
+    }
+
+    /// `t` as a number times integer powers of factors, `(c, [(factor, exponent)])`; `None`
+    /// where a power is not an integer.
+    fn monomial(&mut self, t: ExprId) -> Option<(Constant, Vec<(ExprId, i64)>)> {
+        let (c, rest) = self.split_coefficient(t);
+        let Some(rest) = rest else {
+            return Some((c, Vec::new()));
+        };
+        let factors: Vec<ExprId> = match self.node(rest) {
+            Node::Mul(f) => f.to_vec(),
+            _ => vec![rest],
+        };
+        factors
+            .into_iter()
+            .map(|f| match self.node(f) {
+                Node::Pow([b, e]) => {
+                    let (b, e) = (*b, *e);
+                    Some((b, self.as_constant(e)?.as_integer()?))
+                }
+                _ => Some((f, 1)),
+            })
+            .collect::<Option<Vec<_>>>()
+            .map(|f| (c, f))
+    }
+}
+
+impl ExprArena {
+    /// The sum of `terms` with terms paired greedily by their largest common factor (at
+    /// least two factors, counted with their powers; a sum factor and its negation count as
+    /// the same, `I₃ − I₁` and `I₁ − I₃`) and each pair written `C (R₁ + R₂)`:
+    /// `a cos²ψ (I₃ − I₁) + a sin²ψ (I₁ − I₃)` → `a (I₃ − I₁) (cos²ψ − sin²ψ)`. Sums of more
+    /// than `MOST_PAIRED_TERMS` terms are left as they are.
+    fn factored_pairs(&mut self, terms: &[ExprId]) -> ExprId {
+        const MOST_PAIRED_TERMS: usize = 16;
+        if terms.len() < 2 || terms.len() > MOST_PAIRED_TERMS {
+            return self.sum(terms);
+        }
+        let split: Vec<Option<(Constant, Vec<(ExprId, i64)>)>> =
+            terms.iter().map(|&t| self.monomial(t)).collect();
+        let mut used = vec![false; terms.len()];
+        let mut out = Vec::with_capacity(terms.len());
+        for i in 0..terms.len() {
+            let Some((ci, fi)) = split[i].clone().filter(|_| !used[i]) else {
+                continue;
+            };
+            // The partner sharing the most factors: `(j, shared units, its factors with any
+            // negated sum turned back, and whether that flipped its sign)`.
+            let mut best: Option<(usize, i64, Vec<(ExprId, i64)>, bool)> = None;
+            for j in i + 1..terms.len() {
+                let Some((_, fj)) = split[j].as_ref().filter(|_| !used[j]) else {
+                    continue;
+                };
+                let (fj, flipped) = self.aligned_factors(&fi, fj);
+                let shared: i64 = (fi.iter())
+                    .map(|(b, e)| common_power(*e, exponent_of(&fj, *b)))
+                    .sum();
+                if shared >= 2 && best.as_ref().is_none_or(|(_, s, ..)| shared > *s) {
+                    best = Some((j, shared, fj, flipped));
+                }
+            }
+            let Some((j, _, fj, flipped)) = best else {
+                continue;
+            };
+            let Some((cj, _)) = split[j] else { continue };
+            used[i] = true;
+            used[j] = true;
+            let cj = if flipped { cj.negated() } else { cj };
+            let mut bases: Vec<ExprId> = fi.iter().chain(&fj).map(|(b, _)| *b).collect();
+            bases.sort_unstable();
+            bases.dedup();
+            let (mut common, mut ri, mut rj) =
+                (Vec::new(), vec![self.constant(ci)], vec![self.constant(cj)]);
+            for b in bases {
+                let (ei, ej) = (exponent_of(&fi, b), exponent_of(&fj, b));
+                let c = common_power(ei, ej);
+                for (list, e) in [(&mut common, c), (&mut ri, ei - c), (&mut rj, ej - c)] {
+                    if e != 0 {
+                        let e = self.int(e);
+                        list.push(self.pow(b, e));
+                    }
+                }
+            }
+            let (common, ri, rj) = (self.product(&common), self.product(&ri), self.product(&rj));
+            let inner = self.plus(ri, rj);
+            out.push(self.times(common, inner));
+        }
+        out.extend((0..terms.len()).filter(|&i| !used[i]).map(|i| terms[i]));
+        self.sum(&out)
+    }
+
+    /// `other`'s factors with each sum that is the negation of one of `factors`' sums replaced
+    /// by that sum, and whether that flipped the sign (an odd number of odd powers).
+    fn aligned_factors(
+        &mut self,
+        factors: &[(ExprId, i64)],
+        other: &[(ExprId, i64)],
+    ) -> (Vec<(ExprId, i64)>, bool) {
+        let mut flipped = false;
+        let aligned = (other.iter())
+            .map(|&(b, e)| {
+                if matches!(self.node(b), Node::Add(_)) && exponent_of(factors, b) == 0 {
+                    let negated = self.neg(b);
+                    if exponent_of(factors, negated) != 0 {
+                        flipped ^= e % 2 != 0;
+                        return (negated, e);
+                    }
+                }
+                (b, e)
+            })
+            .collect();
+        (aligned, flipped)
+    }
+}
+
+/// The power of a base two monomials share: the lower of two positive exponents, else 0.
+fn common_power(a: i64, b: i64) -> i64 {
+    if a > 0 && b > 0 { a.min(b) } else { 0 }
+}
+
+/// The exponent of `base` among `factors` (0 if absent).
+fn exponent_of(factors: &[(ExprId, i64)], base: ExprId) -> i64 {
+    factors
+        .iter()
+        .find(|(b, _)| *b == base)
+        .map_or(0, |(_, e)| *e)
+}
+
+/// The square root of a non-negative integer that is a perfect square.
+fn integer_sqrt(n: i64) -> Option<i64> {
+    if n < 0 {
+        return None;
+    }
+    let r = (n as f64).sqrt().round() as i64;
+    (r.checked_mul(r) == Some(n)).then_some(r)
+}
+
+/// The length of `x` as the listings print it, spaces aside (they only set the operators
+/// apart): what [`ExprArena::readable`] shortens.
+fn printed_length(arena: &ExprArena, x: ExprId) -> usize {
+    let text = Printer::for_display(arena, Syntax::Text).print(x);
+    text.chars().filter(|c| !c.is_whitespace()).count()
 }
 
 /// The least common multiple of two positive integers; `None` past `i64`.
