@@ -351,7 +351,7 @@ impl ExprArena {
 
     /// `t` as a number times integer powers of factors, `(c, [(factor, exponent)])`; `None`
     /// where a power is not an integer.
-    fn monomial(&mut self, t: ExprId) -> Option<(Constant, Vec<(ExprId, i64)>)> {
+    fn monomial(&mut self, t: ExprId) -> Option<Monomial> {
         let (c, rest) = self.split_coefficient(t);
         let Some(rest) = rest else {
             return Some((c, Vec::new()));
@@ -385,8 +385,7 @@ impl ExprArena {
         if terms.len() < 2 || terms.len() > MOST_PAIRED_TERMS {
             return self.sum(terms);
         }
-        let split: Vec<Option<(Constant, Vec<(ExprId, i64)>)>> =
-            terms.iter().map(|&t| self.monomial(t)).collect();
+        let split: Vec<Option<Monomial>> = terms.iter().map(|&t| self.monomial(t)).collect();
         let mut used = vec![false; terms.len()];
         let mut out = Vec::with_capacity(terms.len());
         for i in 0..terms.len() {
@@ -395,7 +394,7 @@ impl ExprArena {
             };
             // The partner sharing the most factors: `(j, shared units, its factors with any
             // negated sum turned back, and whether that flipped its sign)`.
-            let mut best: Option<(usize, i64, Vec<(ExprId, i64)>, bool)> = None;
+            let mut best: Option<(usize, i64, Factors, bool)> = None;
             for j in i + 1..terms.len() {
                 let Some((_, fj)) = split[j].as_ref().filter(|_| !used[j]) else {
                     continue;
@@ -474,6 +473,12 @@ fn exponent_of(factors: &[(ExprId, i64)], base: ExprId) -> i64 {
         .find(|(b, _)| *b == base)
         .map_or(0, |(_, e)| *e)
 }
+
+/// Factors and their integer powers, `[(factor, exponent)]`.
+type Factors = Vec<(ExprId, i64)>;
+
+/// A number times integer powers of factors ([`ExprArena::monomial`]).
+type Monomial = (Constant, Factors);
 
 /// The square root of a non-negative integer that is a perfect square.
 fn integer_sqrt(n: i64) -> Option<i64> {
