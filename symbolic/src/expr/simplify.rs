@@ -328,15 +328,12 @@ impl ExprArena {
         );
         for b in bases {
             let (ep, eq) = (exponent(&fp, b), exponent(&fq, b));
-            if (ep - eq) % 2 != 0 {
+            if ep.checked_sub(eq)? % 2 != 0 {
                 return None;
             }
             let low = ep.min(eq);
-            for (list, e) in [
-                (&mut k, low),
-                (&mut a, (ep - low) / 2),
-                (&mut bb, (eq - low) / 2),
-            ] {
+            let (half_p, half_q) = (ep.checked_sub(low)? / 2, eq.checked_sub(low)? / 2);
+            for (list, e) in [(&mut k, low), (&mut a, half_p), (&mut bb, half_q)] {
                 if e != 0 {
                     let e = self.int(e);
                     list.push(self.pow(b, e));
@@ -402,7 +399,7 @@ impl ExprArena {
                 let (fj, flipped) = self.aligned_factors(&fi, fj);
                 let shared: i64 = (fi.iter())
                     .map(|(b, e)| common_power(*e, exponent_of(&fj, *b)))
-                    .sum();
+                    .fold(0, i64::saturating_add);
                 if shared >= 2 && best.as_ref().is_none_or(|(_, s, ..)| shared > *s) {
                     best = Some((j, shared, fj, flipped));
                 }
@@ -443,20 +440,31 @@ impl ExprArena {
         &mut self,
         factors: &[(ExprId, i64)],
         other: &[(ExprId, i64)],
-    ) -> (Vec<(ExprId, i64)>, bool) {
+    ) -> (Factors, bool) {
         let mut flipped = false;
-        let aligned = (other.iter())
-            .map(|&(b, e)| {
-                if matches!(self.node(b), Node::Add(_)) && exponent_of(factors, b) == 0 {
-                    let negated = self.neg(b);
-                    if exponent_of(factors, negated) != 0 {
-                        flipped ^= e % 2 != 0;
-                        return (negated, e);
-                    }
+        let mut aligned: Factors = Vec::with_capacity(other.len());
+        for &(b, e) in other {
+            let mut base = b;
+            if let Node::Add(terms) = self.node(b)
+                && exponent_of(factors, b) == 0
+            {
+                // The sum negated term by term: the canonical node of `I₃ − I₁` (`neg`
+                // would give `−1 · (I₁ − I₃)`, a product).
+                let terms = terms.to_vec();
+                let negated: Vec<ExprId> = terms.iter().map(|&t| self.neg(t)).collect();
+                let negated = self.sum(&negated);
+                if exponent_of(factors, negated) != 0 {
+                    flipped ^= e % 2 != 0;
+                    base = negated;
                 }
-                (b, e)
-            })
-            .collect();
+            }
+            // A base met twice (a sum and its negation both in `other`) has its powers added.
+            match aligned.iter_mut().find(|(x, _)| *x == base) {
+                Some((_, power)) => *power = power.saturating_add(e),
+                None => aligned.push((base, e)),
+            }
+        }
+        aligned.retain(|(_, e)| *e != 0);
         (aligned, flipped)
     }
 }
