@@ -372,9 +372,10 @@ impl ExprArena {
 }
 
 impl ExprArena {
-    /// The sum of `terms` with terms paired greedily by their largest common factor (at
-    /// least two factors, counted with their powers; a sum factor and its negation count as
-    /// the same, `I₃ − I₁` and `I₁ − I₃`) and each pair written `C (R₁ + R₂)`:
+    /// The sum of `terms` with terms of the same rates paired greedily by their largest
+    /// common factor (at least two factors, counted with their powers; a sum factor and its
+    /// negation count as the same, `I₃ − I₁` and `I₁ − I₃`) and each pair written
+    /// `C (R₁ + R₂)`:
     /// `a cos²ψ (I₃ − I₁) + a sin²ψ (I₁ − I₃)` → `a (I₃ − I₁) (cos²ψ − sin²ψ)`. Sums of more
     /// than `MOST_PAIRED_TERMS` terms are left as they are.
     fn factored_pairs(&mut self, terms: &[ExprId]) -> ExprId {
@@ -396,6 +397,11 @@ impl ExprArena {
                 let Some((_, fj)) = split[j].as_ref().filter(|_| !used[j]) else {
                     continue;
                 };
+                // Only terms of the same rates: a kinetic energy stays a sum over products
+                // of rates (`θ̇₁ θ̇₂ cos(θ₁ − θ₂)` apart from `θ̇₂²`), as a textbook writes it.
+                if self.rates_of(&fi) != self.rates_of(fj) {
+                    continue;
+                }
                 let (fj, flipped) = self.aligned_factors(&fi, fj);
                 let shared: i64 = (fi.iter())
                     .map(|(b, e)| common_power(*e, exponent_of(&fj, *b)))
@@ -432,6 +438,21 @@ impl ExprArena {
         }
         out.extend((0..terms.len()).filter(|&i| !used[i]).map(|i| terms[i]));
         self.sum(&out)
+    }
+
+    /// The rates among `factors` and their powers, in order.
+    fn rates_of(&self, factors: &[(ExprId, i64)]) -> Factors {
+        let mut rates: Factors = (factors.iter())
+            .filter(|(b, _)| match self.node(*b) {
+                Node::Symbol(s) => {
+                    matches!(self.symbol_info(*s).kind, super::SymbolKind::Velocity(_))
+                }
+                _ => false,
+            })
+            .copied()
+            .collect();
+        rates.sort_unstable();
+        rates
     }
 
     /// `other`'s factors with each sum that is the negation of one of `factors`' sums replaced
