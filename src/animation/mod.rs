@@ -220,9 +220,8 @@ pub struct Scene {
     /// The bodies' centres of mass (points marked with a ring), with whether the body is
     /// rigid, and the body's name.
     centres: Vec<(usize, bool, String)>,
-    /// Isometric view of a 3-D model.
-    three_d: bool,
-    /// The 3-D bodies, their solids and orientations (a 3-D model's scene only).
+    /// The 3-D bodies, their solids and orientations: a 3-D model's scene (drawn in the 3-D
+    /// view, projected isometrically for the GIF and the fallback), `None` for a planar one.
     poses: Option<pose::Poses>,
     /// Indices of the drawn points among the model's points.
     model_points: Vec<usize>,
@@ -308,7 +307,6 @@ impl Scene {
                 .iter()
                 .map(|(i, rigid, body)| (local(*i), *rigid, body.clone()))
                 .collect(),
-            three_d: false,
             poses: None,
             model_points: used,
         })
@@ -328,7 +326,7 @@ impl Scene {
         let layout = Layout {
             lines: Vec::new(),
             dots: Vec::new(),
-            three_d: self.three_d,
+            three_d: self.three_d(),
         };
         self.model_points
             .iter()
@@ -341,7 +339,6 @@ impl Scene {
     /// # Errors
     /// As [`pose::Poses::of`].
     fn make_three_d(&mut self, model: &dyn ModelInfo) -> Result<(), AnimationError> {
-        self.three_d = true;
         self.poses = Some(pose::Poses::of(model)?);
         Ok(())
     }
@@ -363,6 +360,11 @@ impl Scene {
         };
         let points = self.model_points.iter().map(|&i| positions[i]).collect();
         Ok(Some((points, poses.at(model, t, q, positions)?)))
+    }
+
+    /// Whether the scene is a 3-D model's.
+    fn three_d(&self) -> bool {
+        self.poses.is_some()
     }
 
     /// The 3-D bodies drawn, with their solids (empty for a planar scene).
@@ -620,7 +622,14 @@ pub fn simulation_animation(
     let n = model.description().num_dofs();
     // The 3-D view's frames: `(t, y, positions)`, posed once every point is known finite.
     let mut in_space = Vec::new();
-    let mut space_trail = vec![Vec::new(); if scene.three_d { scene.traces.len() } else { 0 }];
+    let mut space_trail = vec![
+        Vec::new();
+        if scene.three_d() {
+            scene.traces.len()
+        } else {
+            0
+        }
+    ];
     let mut t = Vec::with_capacity(samples / sub + 1);
     let mut frames = Vec::with_capacity(samples / sub + 1);
     let mut frame_states = Vec::with_capacity(samples / sub + 1);
@@ -652,7 +661,7 @@ pub fn simulation_animation(
         if j % sub != 0 {
             continue;
         }
-        if scene.three_d {
+        if scene.three_d() {
             in_space.push((tk, y, positions));
         }
         t.push(tk);
@@ -666,7 +675,7 @@ pub fn simulation_animation(
         simulation,
         options,
         (&t, e0, max_drift),
-        scene.three_d,
+        scene.three_d(),
     );
     check_finite(&scene.model, &frames)?;
     check_finite(&scene.model, &trail)?;
@@ -677,7 +686,7 @@ pub fn simulation_animation(
     for (tk, y, positions) in &in_space {
         space.push(scene.space_frame(model, *tk, &y[..n], positions)?);
     }
-    let space = scene.three_d.then_some(space);
+    let space = scene.three_d().then_some(space);
     check_space(&scene.model, space.as_ref())?;
     let clip = Clip {
         label: "simulation".to_string(),
@@ -872,7 +881,7 @@ pub fn modes_animation(
     let layout = Layout {
         lines: Vec::new(),
         dots: scene.model_points.clone(),
-        three_d: scene.three_d,
+        three_d: scene.three_d(),
     };
     let positions = |qk: &[f64]| drawing::positions(model, qk);
     let rest = scene.project(&positions(q));
@@ -906,7 +915,7 @@ pub fn modes_animation(
         space.trail = (scene.traces.iter())
             .map(|&p| space.points.iter().map(|f| f[p]).collect())
             .collect();
-        let space = scene.three_d.then_some(space);
+        let space = scene.three_d().then_some(space);
         check_space(&scene.model, space.as_ref())?;
         let described = drawing::describe(k + 1, omega, kind, c_left_out);
         let motion = match s {

@@ -393,13 +393,14 @@ impl ExprArena {
             // The partner sharing the most factors: `(j, shared units, its factors with any
             // negated sum turned back, and whether that flipped its sign)`.
             let mut best: Option<(usize, i64, Factors, bool)> = None;
+            let rates = self.rates_of(&fi);
             for j in i + 1..terms.len() {
                 let Some((_, fj)) = split[j].as_ref().filter(|_| !used[j]) else {
                     continue;
                 };
                 // Only terms of the same rates: a kinetic energy stays a sum over products
                 // of rates (`θ̇₁ θ̇₂ cos(θ₁ − θ₂)` apart from `θ̇₂²`), as a textbook writes it.
-                if self.rates_of(&fi) != self.rates_of(fj) {
+                if rates != self.rates_of(fj) {
                     continue;
                 }
                 let (fj, flipped) = self.aligned_factors(&fi, fj);
