@@ -677,6 +677,15 @@ fn readable_forms_keep_every_value_and_print_no_longer() {
             // 214 characters (spaces aside) without the pairing, about 180 with it.
             let length = f2.chars().filter(|c| !c.is_whitespace()).count();
             assert!(length < 200, "{length}: {f2}");
+            // Double angles: `(I₁ − I₃)(cos²ψ − sin²ψ)` as `(I₁ − I₃) cos 2ψ`.
+            let f1 = p.print(simplified[n * n + 1]);
+            assert!(f1.contains("(I1 - I3)*cos(2*psi)"), "{f1}");
+        }
+        // The rod's `1/(1 − r² sin²θ/l²)` with its fraction cleared, as the other terms'
+        // divisor `l² − r² sin²θ`.
+        if path.ends_with("slider_crank.yaml") {
+            let t = p.print(model.kinetic);
+            assert!(t.contains("l^2/(l^2 - r^2*sin(theta)^2)"), "{t}");
         }
     }
     assert!(after < before, "{after} characters against {before}");

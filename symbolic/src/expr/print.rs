@@ -4,6 +4,10 @@
 //! and calls are spelled. Sums print their non-constant terms first with negative
 //! coefficients as subtraction; products print negative powers as a denominator.
 
+use std::cell::RefCell;
+
+use rustc_hash::FxHashMap;
+
 use super::{Constant, ExprArena, ExprId, Func, Node, SymbolId};
 
 /// Target syntax of a [`Printer`].
@@ -40,7 +44,18 @@ pub struct Printer<'a> {
     helpers: String,
     /// See [`Printer::for_display`].
     display_limit: Option<u64>,
+    /// See [`Printer::with_memo`].
+    memo: Option<&'a PrintMemo>,
 }
+
+/// Printed subexpressions kept between printers of one arena and syntax
+/// ([`Printer::with_memo`]).
+#[derive(Default)]
+pub struct PrintMemo(RefCell<FxHashMap<ExprId, (String, Prec)>>);
+
+/// The longest text of one subexpression a [`PrintMemo`] keeps: longer ones are printed
+/// again, so that the memo's size stays within a few times the number of nodes.
+const MOST_MEMO_TEXT: usize = 1_000;
 
 /// The most operations (as a tree, [`ExprArena::tree_operation_count`]) of an expression that
 /// [`Printer::for_display`] prints: about 200 kB of text on one line. Past it a printed tree
@@ -65,6 +80,7 @@ impl<'a> Printer<'a> {
             temporary: Box::new(|_| None),
             helpers: "crate".to_string(),
             display_limit: None,
+            memo: None,
         }
     }
 
@@ -77,6 +93,14 @@ impl<'a> Printer<'a> {
             display_limit: Some(DISPLAY_LIMIT),
             ..Self::new(arena, syntax)
         }
+    }
+
+    /// Keeps the text of each subexpression printed in `memo` and reuses it: for printing
+    /// many expressions that share subexpressions, by printers of the same syntax and
+    /// configuration over the same arena (the readable forms' lengths).
+    pub fn with_memo(mut self, memo: &'a PrintMemo) -> Self {
+        self.memo = Some(memo);
+        self
     }
 
     /// Names symbols with `f` instead.
@@ -126,10 +150,20 @@ impl<'a> Printer<'a> {
     }
 
     fn operand(&self, e: ExprId) -> (String, Prec) {
-        match (self.temporary)(e) {
-            Some(name) => (name, Prec::Atom),
-            None => self.node(e),
+        if let Some(name) = (self.temporary)(e) {
+            return (name, Prec::Atom);
         }
+        let Some(memo) = self.memo else {
+            return self.node(e);
+        };
+        if let Some(text) = memo.0.borrow().get(&e) {
+            return text.clone();
+        }
+        let text = self.node(e);
+        if text.0.len() <= MOST_MEMO_TEXT {
+            memo.0.borrow_mut().insert(e, text.clone());
+        }
+        text
     }
 
     fn wrap(&self, (s, p): (String, Prec), min: Prec) -> String {
@@ -268,6 +302,16 @@ impl<'a> Printer<'a> {
                 .copied()
                 .filter(|t| self.arena.as_constant(*t).is_some()),
         );
+        // A reader's order: a positive term first where the first is negative (`R φ̇² cos θ − g`,
+        // not `−g + R φ̇² cos θ`). Only for display: generated code keeps the canonical order,
+        // the one its compiled twin evaluates.
+        if self.display_limit.is_some()
+            && ordered.first().is_some_and(|&t| self.is_negative_term(t))
+            && let Some(k) = ordered.iter().position(|&t| !self.is_negative_term(t))
+        {
+            let t = ordered.remove(k);
+            ordered.insert(0, t);
+        }
         let mathml = self.syntax == Syntax::MathMl;
         let (minus, plus, between_minus) = if mathml {
             ("<mo>\u{2212}</mo>", "<mo>+</mo>", "<mo>\u{2212}</mo>")
@@ -298,6 +342,18 @@ impl<'a> Printer<'a> {
             out = format!("<mrow>{out}</mrow>");
         }
         (out, Prec::Sum)
+    }
+
+    /// Whether [`Self::signed_term`] prints `t` with a minus sign (without printing it).
+    fn is_negative_term(&self, t: ExprId) -> bool {
+        if (self.temporary)(t).is_some() {
+            return false;
+        }
+        match self.arena.node(t) {
+            Node::Const(c) => c.is_negative(),
+            Node::Mul(factors) => self.split(factors).0.is_negative(),
+            _ => false,
+        }
     }
 
     /// A term of a sum as (is negative, printed magnitude).

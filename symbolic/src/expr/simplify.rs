@@ -9,8 +9,13 @@
 //! and cancel and `sin² u + cos² u` becomes 1 as the canonical sum is built, then groups the
 //! terms by their time-varying factors with the common factors pulled out
 //! ([`ExprArena::collect_time_varying`]), and keeps whichever of the written and the
-//! simplified forms prints shorter. The value is unchanged (the same rules the equality proof
-//! of `eomgen check` uses); `tests` evaluate both at random states.
+//! simplified forms prints shorter. On those forms, rules rewrite node by node where that
+//! prints shorter: `a sin²u + b cos²u` with unlike numbers,
+//! double angles (`(I₁ − I₃)(cos²ψ − sin²ψ) = (I₁ − I₃) cos 2ψ`), terms paired by a shared
+//! factor, fractions over a common divisor with their numerator multiplied out (so that
+//! `−1/D + r² cos²θ/D²` with `D = l² − r² sin²θ` becomes `(r² − l²)/D²`), a denominator's
+//! fractions cleared, and numbers and signs moved into or out of a sum. Each step is an
+//! identity, so the value is unchanged; `tests` evaluate both forms at random states.
 //!
 //! # References
 //! SymPy's `expand`, `trigsimp` and `collect` (Meurer et al., *PeerJ Comput. Sci.* 3:e103,
@@ -18,7 +23,9 @@
 
 use rustc_hash::FxHashMap;
 
-use super::print::{Printer, Syntax};
+mod node_rules;
+
+use super::print::{PrintMemo, Printer, Syntax};
 use super::{Constant, ExprArena, ExprId, Node};
 
 /// Most operations (written out as a tree) of an expression that [`ExprArena::readable`]
@@ -53,23 +60,26 @@ impl ExprArena {
         let flat = self.sums_rewritten(e, Self::flattened_sum);
         let expanded = self.expand_bounded(flat);
         let collected = self.collect_time_varying(expanded);
-        let mut candidates = vec![flat, expanded, collected];
+        let mut candidates = vec![];
         for x in [flat, collected] {
-            let over = self.sums_rewritten(x, Self::over_common_denominator);
-            candidates.push(over);
+            candidates.push(self.sums_rewritten(x, Self::over_common_denominator));
         }
-        for x in [expanded, collected] {
-            let one = self.sums_rewritten(x, Self::pair_squares);
-            let over = self.sums_rewritten(one, Self::over_common_denominator);
-            candidates.extend([one, over]);
-        }
-        // Pairing shortens some sums and lengthens others: taken sum by sum where it pays.
-        let paired = self.sums_shortened(collected, Self::factored_pairs);
-        let over = self.sums_shortened(paired, Self::over_common_denominator);
+        let mut lengths = Lengths::default();
         let square = self.sums_rewritten(expanded, Self::perfect_squares);
-        candidates.extend([paired, over, square]);
+        if square != expanded {
+            candidates.push(self.rules_composed(square, &mut lengths));
+        }
+        // Every node rule where it pays, composed node by node: on the written form, the
+        // collected form, the expanded form over common divisors (`together`), and that
+        // collected. (Of the forms tried on every bundled model and fixture, these are the
+        // ones some entry needs to print shortest.)
+        let together = self.sums_rewritten(expanded, Self::over_common_divisor);
+        let together_collected = self.collect_time_varying(together);
+        for x in [flat, collected, together, together_collected] {
+            candidates.push(self.rules_composed(x, &mut lengths));
+        }
         candidates.into_iter().fold(e, |best, x| {
-            if printed_length(self, x) < printed_length(self, best) {
+            if lengths.printed(self, x) < lengths.printed(self, best) {
                 x
             } else {
                 best
@@ -77,47 +87,117 @@ impl ExprArena {
         })
     }
 
-    /// [`Self::sums_rewritten`] keeping, at each sum, the shorter to print of the sum as it is
-    /// and as `rule` writes it: a rule that shortens one sum of an expression and lengthens
-    /// another (`(m₁ + 3 m₂)/6` against `m₁/6 + m₂/2`) is taken where it pays.
-    fn sums_shortened(&mut self, e: ExprId, rule: fn(&mut Self, &[ExprId]) -> ExprId) -> ExprId {
-        self.sums_walk(e, rule, true)
-    }
-
     /// `e` rebuilt bottom up (memoised) with each sum of (rebuilt) terms made by `rule`, and
     /// every other node by the canonical constructors: the walk the printing forms share.
     fn sums_rewritten(&mut self, e: ExprId, rule: fn(&mut Self, &[ExprId]) -> ExprId) -> ExprId {
-        self.sums_walk(e, rule, false)
-    }
-
-    /// The walk of [`Self::sums_rewritten`] and [`Self::sums_shortened`].
-    fn sums_walk(
-        &mut self,
-        e: ExprId,
-        rule: fn(&mut Self, &[ExprId]) -> ExprId,
-        shortest: bool,
-    ) -> ExprId {
         let mut memo: FxHashMap<ExprId, ExprId> = FxHashMap::default();
         for x in self.reachable(&[e]) {
-            let node = self.node(x).clone();
-            let children: Vec<ExprId> = node.children().iter().map(|c| memo[c]).collect();
-            let out = match node {
-                Node::Add(_) if shortest => {
-                    let plain = self.sum(&children);
-                    let ruled = rule(self, &children);
-                    match printed_length(self, ruled) <= printed_length(self, plain) {
-                        true => ruled,
-                        false => plain,
-                    }
+            let out = match self.node(x) {
+                Node::Add(terms) => {
+                    let terms: Vec<ExprId> = terms.iter().map(|c| memo[c]).collect();
+                    rule(self, &terms)
                 }
-                Node::Add(_) => rule(self, &children),
-                Node::Mul(_) => self.product(&children),
-                Node::Pow(_) => self.pow(children[0], children[1]),
-                Node::Func(f, _) => self.func(f, children[0]),
-                Node::Atan2(_) => self.atan2(children[0], children[1]),
-                Node::Const(_) | Node::Pi | Node::Symbol(_) => x,
+                _ => self.rebuilt(x, &memo),
             };
             memo.insert(x, out);
+        }
+        memo.get(&e).copied().unwrap_or(e)
+    }
+
+    /// The node `x` built anew by the canonical constructors from its children as `memo`
+    /// maps them.
+    fn rebuilt(&mut self, x: ExprId, memo: &FxHashMap<ExprId, ExprId>) -> ExprId {
+        let node = self.node(x).clone();
+        let children: Vec<ExprId> = node.children().iter().map(|c| memo[c]).collect();
+        match node {
+            Node::Add(_) => self.sum(&children),
+            Node::Mul(_) => self.product(&children),
+            Node::Pow(_) => self.pow(children[0], children[1]),
+            Node::Func(f, _) => self.func(f, children[0]),
+            Node::Atan2(_) => self.atan2(children[0], children[1]),
+            Node::Const(_) | Node::Pi | Node::Symbol(_) => x,
+        }
+    }
+
+    /// `e` with the printing rules applied node by node where each shortens the node, in
+    /// order, bottom up and again on the result until it no longer shortens (at most three
+    /// passes, so that a sum a rule builds, `C (R₁ + R₂)`, is itself ruled):
+    /// - sums: [`Self::pair_squares`], [`Self::double_angles`], [`Self::factored_pairs`],
+    ///   [`Self::over_common_denominator`], [`Self::over_common_divisor`];
+    /// - products: [`Self::double_angle_product`], [`Self::denominator_multiplied`],
+    ///   [`Self::number_multiplied_in`], [`Self::sign_taken_out`] (last, so that it wins a
+    ///   tie: its sign then merges with the sum around it);
+    /// - powers: [`Self::denominator_cleared`].
+    ///
+    /// `lengths` keeps the lengths met, for the next call on the same expression.
+    fn rules_composed(&mut self, e: ExprId, lengths: &mut Lengths) -> ExprId {
+        let mut x = e;
+        for _ in 0..3 {
+            let next = self.rules_pass(x, lengths);
+            if self.cached_length(lengths, next) >= self.cached_length(lengths, x) {
+                break;
+            }
+            x = next;
+        }
+        x
+    }
+
+    /// The length of `x` as a factor of a product ([`Lengths`]), kept in `lengths`.
+    fn cached_length(&self, lengths: &mut Lengths, x: ExprId) -> usize {
+        if let Some(&l) = lengths.factor.get(&x) {
+            return l;
+        }
+        let parentheses = match self.node(x) {
+            Node::Add(_) => 2,
+            _ => 0,
+        };
+        let l = lengths.printed(self, x) + parentheses;
+        lengths.factor.insert(x, l);
+        l
+    }
+
+    /// One bottom-up pass of [`Self::rules_composed`] (memoised), with the
+    /// lengths met kept in `lengths`.
+    fn rules_pass(&mut self, e: ExprId, lengths: &mut Lengths) -> ExprId {
+        type SumRule = fn(&mut ExprArena, &[ExprId]) -> ExprId;
+        type NodeRule = fn(&mut ExprArena, ExprId) -> Option<ExprId>;
+        enum Rule {
+            Sum(SumRule),
+            Node(NodeRule),
+        }
+        let rules = [
+            Rule::Sum(Self::pair_squares),
+            Rule::Sum(Self::double_angles),
+            Rule::Sum(Self::factored_pairs),
+            Rule::Sum(Self::over_common_denominator),
+            Rule::Sum(Self::over_common_divisor),
+            Rule::Node(Self::double_angle_product),
+            Rule::Node(Self::denominator_multiplied),
+            Rule::Node(Self::number_multiplied_in),
+            Rule::Node(Self::sign_taken_out),
+            Rule::Node(Self::denominator_cleared),
+        ];
+        let mut memo: FxHashMap<ExprId, ExprId> = FxHashMap::default();
+        for x in self.reachable(&[e]) {
+            let mut best = self.rebuilt(x, &memo);
+            let mut length = self.cached_length(lengths, best);
+            for rule in &rules {
+                let candidate = match (rule, self.node(best)) {
+                    (Rule::Sum(r), Node::Add(terms)) => {
+                        let terms = terms.to_vec();
+                        Some(r(self, &terms))
+                    }
+                    (Rule::Sum(_), _) => None,
+                    (Rule::Node(r), _) => r(self, best),
+                };
+                if let Some(c) = candidate.filter(|&c| c != best) {
+                    let l = self.cached_length(lengths, c);
+                    if l <= length {
+                        (best, length) = (c, l);
+                    }
+                }
+            }
+            memo.insert(x, best);
         }
         memo.get(&e).copied().unwrap_or(e)
     }
@@ -467,14 +547,12 @@ impl ExprArena {
         let mut aligned: Factors = Vec::with_capacity(other.len());
         for &(b, e) in other {
             let mut base = b;
-            if let Node::Add(terms) = self.node(b)
+            if let Node::Add(_) = self.node(b)
                 && exponent_of(factors, b) == 0
             {
                 // The sum negated term by term: the canonical node of `I₃ − I₁` (`neg`
                 // would give `−1 · (I₁ − I₃)`, a product).
-                let terms = terms.to_vec();
-                let negated: Vec<ExprId> = terms.iter().map(|&t| self.neg(t)).collect();
-                let negated = self.sum(&negated);
+                let negated = self.neg_terms(b);
                 if exponent_of(factors, negated) != 0 {
                     flipped ^= e % 2 != 0;
                     base = negated;
@@ -519,18 +597,37 @@ fn integer_sqrt(n: i64) -> Option<i64> {
     (r.checked_mul(r) == Some(n)).then_some(r)
 }
 
-/// The length of `x` as the listings print it, spaces aside (they only set the operators
-/// apart): what [`ExprArena::readable`] shortens.
-fn printed_length(arena: &ExprArena, x: ExprId) -> usize {
-    let text = Printer::for_display(arena, Syntax::Text).print(x);
-    text.chars().filter(|c| !c.is_whitespace()).count()
+/// The printed lengths the readable forms compare: as the listings print an expression,
+/// spaces aside (they only set the operators apart). The printed text of the subexpressions
+/// the candidates share is kept between them.
+#[derive(Default)]
+struct Lengths {
+    /// Lengths of expressions as factors of a product: a sum counts its parentheses, so that
+    /// `(1 + 5 sin²λ)/8` and `1/8 + 5 sin²λ/8`, of one length alone, are told apart.
+    factor: FxHashMap<ExprId, usize>,
+    memo: PrintMemo,
+}
+
+impl Lengths {
+    /// The length of `x` as the listings print it, spaces aside.
+    fn printed(&self, arena: &ExprArena, x: ExprId) -> usize {
+        let text = Printer::for_display(arena, Syntax::Text)
+            .with_memo(&self.memo)
+            .print(x);
+        text.chars().filter(|c| !c.is_whitespace()).count()
+    }
 }
 
 /// The least common multiple of two positive integers; `None` past `i64`.
 fn lcm(a: i64, b: i64) -> Option<i64> {
+    (a / gcd(a, b)).checked_mul(b)
+}
+
+/// The greatest common divisor of two non-negative integers (`gcd(0, b) = b`).
+fn gcd(a: i64, b: i64) -> i64 {
     let (mut x, mut y) = (a, b);
     while y != 0 {
         (x, y) = (y, x % y);
     }
-    (a / x).checked_mul(b)
+    x
 }

@@ -809,3 +809,87 @@ fn derivatives_at_kinks_are_finite() {
     assert_eq!(Func::Sign.apply(0.0), 0.0);
     assert_eq!(Func::Sign.apply(-0.0), 0.0);
 }
+
+/// The node rules of the readable forms, each on the smallest expression that needs it,
+/// printed as a textbook writes it and equal in value to the expression as built (at three
+/// states, to 1e-14 relative): double angles, a fraction over a common divisor (`together`),
+/// a denominator's fractions cleared, a sign taken out of a sum, and a positive term printed
+/// first.
+#[test]
+fn readable_rules_print_textbook_forms() {
+    let mut a = ExprArena::new();
+    let [th, thd, _] = a.coordinate("theta");
+    let [psi, _, _] = a.coordinate("psi");
+    let p = |a: &mut ExprArena, name: &str| a.symbol(name, SymbolKind::Parameter);
+    let (i1, i3, l, r, m, g) = (
+        p(&mut a, "I1"),
+        p(&mut a, "I3"),
+        p(&mut a, "l"),
+        p(&mut a, "r"),
+        p(&mut a, "m"),
+        p(&mut a, "g"),
+    );
+    let (two, minus_one, minus_two) = (a.int(2), a.int(-1), a.int(-2));
+    let (s, c) = (a.sin(psi), a.cos(psi));
+    let (s2, c2) = (a.pow(s, two), a.pow(c, two));
+    let i13 = a.minus(i1, i3);
+    let i31 = a.minus(i3, i1);
+    let x = a.times(i13, c2);
+    let y = a.times(i31, s2);
+    let double_cos = a.plus(x, y);
+    let double_sin = a.product(&[two, thd, s, c]);
+    // D = l² − r² sin²θ; −1/D + r² cos²θ/D²
+    let (st, ct) = (a.sin(th), a.cos(th));
+    let (l2, r2, st2, ct2) = (a.pow(l, two), a.pow(r, two), a.pow(st, two), a.pow(ct, two));
+    let r2st2 = a.times(r2, st2);
+    let d = a.minus(l2, r2st2);
+    let (d1, d2) = (a.pow(d, minus_one), a.pow(d, minus_two));
+    let first = a.neg(d1);
+    let second = a.product(&[r2, ct2, d2]);
+    let together = a.plus(first, second);
+    // 1/(1 − r² sin²θ/l²)
+    let l_2 = a.pow(l, minus_two);
+    let fraction = a.product(&[r2st2, l_2]);
+    let one = a.int(1);
+    let one_minus = a.minus(one, fraction);
+    let cleared = a.pow(one_minus, minus_one);
+    // g − m (r + l) θ̇ written m θ̇ (−r − l) + g, and −g + m r θ̇
+    let nr = a.neg(r);
+    let nl = a.neg(l);
+    let negative = a.plus(nr, nl);
+    let term = a.product(&[m, thd, negative]);
+    let sign = a.plus(term, g);
+    let ng = a.neg(g);
+    let mrt = a.product(&[m, r, thd]);
+    let order = a.plus(ng, mrt);
+    let cases = [
+        (double_cos, "(I1 - I3)*cos(2*psi)"),
+        (double_sin, "theta_dot*sin(2*psi)"),
+        (together, "(r^2 - l^2)/(l^2 - r^2*sin(theta)^2)^2"),
+        (cleared, "l^2/(l^2 - r^2*sin(theta)^2)"),
+        (sign, "g - theta_dot*m*(l + r)"),
+        (order, "theta_dot*r*m - g"),
+    ];
+    let readable: Vec<ExprId> = cases.iter().map(|&(e, _)| a.readable(e)).collect();
+    let printer = Printer::for_display(&a, Syntax::Text);
+    let printed: Vec<String> = readable.iter().map(|&e| printer.print(e)).collect();
+    let expected: Vec<&str> = cases.iter().map(|&(_, text)| text).collect();
+    assert_eq!(printed, expected);
+    let mut roots: Vec<ExprId> = cases.iter().map(|&(e, _)| e).collect();
+    roots.extend(&readable);
+    let mut evaluator = Evaluator::new(&a, &roots);
+    for k in 0..3 {
+        let bindings: Vec<f64> = (0..a.symbols().len())
+            .map(|i| 0.3 + 0.17 * i as f64 + 0.41 * k as f64)
+            .collect();
+        let v = evaluator.eval(&bindings);
+        for i in 0..cases.len() {
+            let (x, y) = (v[i], v[cases.len() + i]);
+            assert!(
+                (x - y).abs() <= 1e-14 * x.abs().max(1.0),
+                "{}: {x} against {y}",
+                expected[i]
+            );
+        }
+    }
+}
