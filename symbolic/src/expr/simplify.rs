@@ -123,9 +123,8 @@ impl ExprArena {
     /// order, bottom up and again on the result until it no longer shortens (at most three
     /// passes, so that a sum a rule builds, `C (R₁ + R₂)`, is itself ruled):
     /// - sums: [`Self::pair_squares`], [`Self::double_angles`], [`Self::factored_pairs`],
-    ///   [`Self::over_common_denominator`], [`Self::over_common_divisor`];
-    /// - products: [`Self::double_angle_product`], [`Self::denominator_multiplied`],
-    ///   [`Self::number_multiplied_in`], [`Self::sign_taken_out`] (last, so that it wins a
+    ///   [`Self::over_common_denominator`], [`Self::over_common_divisor`], [`Self::together`];
+    /// - products: [`Self::double_angle_product`], [`Self::number_multiplied_in`], [`Self::sign_taken_out`] (last, so that it wins a
     ///   tie: its sign then merges with the sum around it);
     /// - powers: [`Self::denominator_cleared`].
     ///
@@ -171,8 +170,8 @@ impl ExprArena {
             Rule::Sum(Self::factored_pairs),
             Rule::Sum(Self::over_common_denominator),
             Rule::Sum(Self::over_common_divisor),
+            Rule::Sum(Self::together),
             Rule::Node(Self::double_angle_product),
-            Rule::Node(Self::denominator_multiplied),
             Rule::Node(Self::number_multiplied_in),
             Rule::Node(Self::sign_taken_out),
             Rule::Node(Self::denominator_cleared),

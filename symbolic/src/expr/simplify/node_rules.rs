@@ -70,10 +70,21 @@ impl ExprArena {
     }
 
     /// The sum of `terms` with those divided by powers of one sum `D` written over the highest
-    /// power, `N/Dᴷ`, the numerator multiplied out (SymPy's `together`): like terms of `N`
-    /// then cancel, `−1/D + r² cos²θ/D²` with `D = l² − r² sin²θ` → `(r² − l²)/D²`. The sum
-    /// `D` chosen is the one that divides the most terms.
+    /// power, `N/Dᴷ`, the numerator multiplied out: like terms of `N` then cancel,
+    /// `−1/D + r² cos²θ/D²` with `D = l² − r² sin²θ` → `(r² − l²)/D²`. The sum `D` chosen is
+    /// the one that divides the most terms.
     pub(super) fn over_common_divisor(&mut self, terms: &[ExprId]) -> ExprId {
+        self.over_divisor(terms, false)
+    }
+
+    /// [`Self::over_common_divisor`] with every term put over `Dᴷ` (SymPy's `together`):
+    /// `1 + y²/(l² − y²)` → `l²/(l² − y²)`.
+    pub(super) fn together(&mut self, terms: &[ExprId]) -> ExprId {
+        self.over_divisor(terms, true)
+    }
+
+    /// [`Self::over_common_divisor`] (`all` false) and [`Self::together`] (`all` true).
+    fn over_divisor(&mut self, terms: &[ExprId], all: bool) -> ExprId {
         const MOST_TERMS: usize = 40;
         if !(2..=MOST_TERMS).contains(&terms.len()) {
             return self.sum(terms);
@@ -92,10 +103,7 @@ impl ExprArena {
                 }
             }
         }
-        let Some(&(d, _, k)) = (divisors.iter())
-            .filter(|(_, count, _)| *count >= 2)
-            .max_by_key(|(_, count, _)| *count)
-        else {
+        let Some(&(d, _, k)) = (divisors.iter()).max_by_key(|(_, count, _)| *count) else {
             return self.sum(&terms);
         };
         let power = self.int(k);
@@ -103,7 +111,8 @@ impl ExprArena {
         let (mut over, mut rest) = (Vec::new(), Vec::new());
         for (i, &t) in terms.iter().enumerate() {
             match &split[i] {
-                Some((_, f)) if exponent_of(f, d) < 0 => over.push(self.times(dk, t)),
+                Some((_, f)) if all || exponent_of(f, d) < 0 => over.push(self.times(dk, t)),
+                _ if all => over.push(self.times(dk, t)),
                 _ => rest.push(t),
             }
         }
@@ -217,48 +226,6 @@ impl ExprArena {
         let doubled = self.times(two, u);
         out.push(self.sin(doubled));
         Some(self.product(&out))
-    }
-
-    /// `x` with its fractional coefficient's denominator multiplied into a sum it divides:
-    /// `1/(24 (1 − a))` → `1/(24 − 24 a)`; `None` where `x` is not such a product.
-    pub(super) fn denominator_multiplied(&mut self, x: ExprId) -> Option<ExprId> {
-        let Node::Mul(factors) = self.node(x) else {
-            return None;
-        };
-        let factors = factors.to_vec();
-        let (c, _) = self.split_coefficient(x);
-        let Constant::Rational { num, den } = c else {
-            return None;
-        };
-        let minus_one = self.int(-1);
-        let divisors: Vec<usize> = (factors.iter().enumerate())
-            .filter(|&(_, &f)| {
-                matches!(self.node(f), Node::Pow([b, e])
-                    if *e == minus_one && matches!(self.node(*b), Node::Add(_)))
-            })
-            .map(|(i, _)| i)
-            .collect();
-        let (&[k], true) = (divisors.as_slice(), den > 1) else {
-            return None;
-        };
-        let Node::Pow([sum, _]) = self.node(factors[k]) else {
-            return None;
-        };
-        let Node::Add(terms) = self.node(*sum) else {
-            return None;
-        };
-        let terms = terms.to_vec();
-        let d = self.int(den);
-        let scaled: Vec<ExprId> = terms.into_iter().map(|t| self.times(d, t)).collect();
-        let scaled = self.sum(&scaled);
-        let mut out = vec![self.int(num), self.add(Node::Pow([scaled, minus_one]))];
-        out.extend(
-            (factors.iter().enumerate())
-                .filter(|&(i, &f)| i != k && self.as_constant(f).is_none())
-                .map(|(_, &f)| f),
-        );
-        // Interned as built: the canonical product would keep the number and the sum apart.
-        Some(self.add(Node::Mul(out.into())))
     }
 
     /// `x = c S R` for a number `c ≠ 1` and a sum `S` (the only one among the factors) with
