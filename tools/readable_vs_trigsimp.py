@@ -85,10 +85,12 @@ def main():
             ours = len(normal(text))
             if ours > args.most:
                 skipped += 1
+                print(f"{model} {name}: skipped, {ours} characters (--most {args.most})")
                 continue
             theirs = trigsimp_length(text, args.seconds)
             if theirs is None:
                 skipped += 1
+                print(f"{model} {name}: skipped, trigsimp past {args.seconds} s")
                 continue
             total += 1
             ours_sum += ours
