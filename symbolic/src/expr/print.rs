@@ -2,7 +2,8 @@
 //!
 //! One printer serves the four syntaxes; they differ only in how atoms, powers, quotients
 //! and calls are spelled. Sums print their non-constant terms first with negative
-//! coefficients as subtraction; products print negative powers as a denominator.
+//! coefficients as subtraction (for display, a positive term leads where the first would be
+//! negative); products print negative powers as a denominator.
 
 use std::cell::RefCell;
 
@@ -54,7 +55,7 @@ pub struct Printer<'a> {
 pub struct PrintMemo(RefCell<FxHashMap<ExprId, (String, Prec)>>);
 
 /// The longest text of one subexpression a [`PrintMemo`] keeps: longer ones are printed
-/// again, so that the memo's size stays within a few times the number of nodes.
+/// again, so that the memo holds at most this many bytes a node.
 const MOST_MEMO_TEXT: usize = 1_000;
 
 /// The most operations (as a tree, [`ExprArena::tree_operation_count`]) of an expression that
@@ -87,7 +88,8 @@ impl<'a> Printer<'a> {
     /// A printer for people to read (equation listings, reports): an expression of more than
     /// [`DISPLAY_LIMIT`] operations as a tree is printed as a note that says so and how many
     /// (the generated code, `equations --rust`, prints it with its shared subexpressions
-    /// named).
+    /// named). A sum whose first term is negative is printed with a positive term first, as
+    /// a reader writes it (`R φ̇² cos θ − g`); the code printers keep the canonical order.
     pub fn for_display(arena: &'a ExprArena, syntax: Syntax) -> Self {
         Self {
             display_limit: Some(DISPLAY_LIMIT),
@@ -306,6 +308,7 @@ impl<'a> Printer<'a> {
         // not `−g + R φ̇² cos θ`). Only for display: generated code keeps the canonical order,
         // the one its compiled twin evaluates.
         if self.display_limit.is_some()
+            && self.syntax != Syntax::Rust
             && ordered.first().is_some_and(|&t| self.is_negative_term(t))
             && let Some(k) = ordered.iter().position(|&t| !self.is_negative_term(t))
         {

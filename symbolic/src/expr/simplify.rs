@@ -25,7 +25,7 @@ use rustc_hash::FxHashMap;
 
 mod node_rules;
 
-use super::print::{PrintMemo, Printer, Syntax};
+use super::print::{DISPLAY_LIMIT, PrintMemo, Printer, Syntax};
 use super::{Constant, ExprArena, ExprId, Node};
 
 /// Most operations (written out as a tree) of an expression that [`ExprArena::readable`]
@@ -150,7 +150,7 @@ impl ExprArena {
             Node::Add(_) => 2,
             _ => 0,
         };
-        let l = lengths.printed(self, x) + parentheses;
+        let l = lengths.printed(self, x).saturating_add(parentheses);
         lengths.factor.insert(x, l);
         l
     }
@@ -163,6 +163,8 @@ impl ExprArena {
         enum Rule {
             Sum(SumRule),
             Node(NodeRule),
+            /// A node rule taken at equal length too.
+            NodeOnTie(NodeRule),
         }
         let rules = [
             Rule::Sum(Self::pair_squares),
@@ -173,7 +175,7 @@ impl ExprArena {
             Rule::Sum(Self::together),
             Rule::Node(Self::double_angle_product),
             Rule::Node(Self::number_multiplied_in),
-            Rule::Node(Self::sign_taken_out),
+            Rule::NodeOnTie(Self::sign_taken_out),
             Rule::Node(Self::denominator_cleared),
         ];
         let mut memo: FxHashMap<ExprId, ExprId> = FxHashMap::default();
@@ -187,11 +189,11 @@ impl ExprArena {
                         Some(r(self, &terms))
                     }
                     (Rule::Sum(_), _) => None,
-                    (Rule::Node(r), _) => r(self, best),
+                    (Rule::Node(r) | Rule::NodeOnTie(r), _) => r(self, best),
                 };
                 if let Some(c) = candidate.filter(|&c| c != best) {
                     let l = self.cached_length(lengths, c);
-                    if l <= length {
+                    if l < length || (l == length && matches!(rule, Rule::NodeOnTie(_))) {
                         (best, length) = (c, l);
                     }
                 }
@@ -608,8 +610,13 @@ struct Lengths {
 }
 
 impl Lengths {
-    /// The length of `x` as the listings print it, spaces aside.
+    /// The length of `x` as the listings print it, spaces aside; `usize::MAX` for an
+    /// expression the listings print as a note that it is too large
+    /// ([`Printer::for_display`]), so that no such form is ever the shortest.
     fn printed(&self, arena: &ExprArena, x: ExprId) -> usize {
+        if arena.tree_operation_count(&[x]) > DISPLAY_LIMIT {
+            return usize::MAX;
+        }
         let text = Printer::for_display(arena, Syntax::Text)
             .with_memo(&self.memo)
             .print(x);

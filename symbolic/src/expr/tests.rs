@@ -359,7 +359,8 @@ fn nested_rotations_are_kept_past_the_expansion_caps() {
 /// A display printer prints an expression as a tree up to `DISPLAY_LIMIT` operations and a
 /// note past it (a DAG whose tree doubles per level: `e ← e·sin(e) + x`, 16 levels), in every
 /// syntax; the code printer (`Printer::new`) still prints it whole, and below the limit both
-/// print the same.
+/// print the same (for a sum that does not start with a negative term, which the display
+/// printer moves behind a positive one).
 #[test]
 fn display_printers_print_a_note_past_the_limit() {
     use super::print::DISPLAY_LIMIT;

@@ -96,9 +96,12 @@ impl ExprArena {
         for (_, factors) in split.iter().flatten() {
             for &(b, e) in factors {
                 if e < 0 && matches!(self.node(b), Node::Add(_)) {
+                    let Some(power) = e.checked_neg() else {
+                        return self.sum(&terms);
+                    };
                     match divisors.iter_mut().find(|(d, ..)| *d == b) {
-                        Some((_, count, k)) => (*count, *k) = (*count + 1, (*k).max(-e)),
-                        None => divisors.push((b, 1, -e)),
+                        Some((_, count, k)) => (*count, *k) = (*count + 1, (*k).max(power)),
+                        None => divisors.push((b, 1, power)),
                     }
                 }
             }
@@ -122,6 +125,30 @@ impl ExprArena {
         let inverse = self.pow(d, minus);
         rest.push(self.times(numerator, inverse));
         self.sum(&rest)
+    }
+
+    /// `D = Π bᵏ` over the factors `b` that divide some of `terms` (monomials), `k` the
+    /// highest power among them: `D` times each term has no divisor left (1 where no term has
+    /// one); `None` where a term is no monomial or a power is past `i64`.
+    fn divisors_of(&mut self, terms: &[ExprId]) -> Option<ExprId> {
+        let mut divisors: Factors = Vec::new();
+        for &t in terms {
+            let (_, factors) = self.monomial(t)?;
+            for (b, e) in factors.into_iter().filter(|(_, e)| *e < 0) {
+                let power = e.checked_neg()?;
+                match divisors.iter_mut().find(|(d, _)| *d == b) {
+                    Some((_, k)) => *k = (*k).max(power),
+                    None => divisors.push((b, power)),
+                }
+            }
+        }
+        let divisors: Vec<ExprId> = (divisors.into_iter())
+            .map(|(b, k)| {
+                let k = self.int(k);
+                self.pow(b, k)
+            })
+            .collect();
+        Some(self.product(&divisors))
     }
 
     /// `t` with each sum `B` it is divided by written `f P`, `P` the primitive part: the
@@ -154,23 +181,7 @@ impl ExprArena {
             return None;
         };
         let terms = terms.to_vec();
-        let mut divisors: Factors = Vec::new();
-        for &t in &terms {
-            let (_, factors) = self.monomial(t)?;
-            for (x, e) in factors.into_iter().filter(|(_, e)| *e < 0) {
-                match divisors.iter_mut().find(|(d, _)| *d == x) {
-                    Some((_, k)) => *k = (*k).max(-e),
-                    None => divisors.push((x, -e)),
-                }
-            }
-        }
-        let divisors: Vec<ExprId> = (divisors.into_iter())
-            .map(|(x, k)| {
-                let k = self.int(k);
-                self.pow(x, k)
-            })
-            .collect();
-        let d = self.product(&divisors);
+        let d = self.divisors_of(&terms)?;
         let cleared: Vec<ExprId> = terms.iter().map(|&t| self.times(d, t)).collect();
         // The content: the gcd of the numerators over the lcm of the denominators, with the
         // sign of the first term.
@@ -188,6 +199,12 @@ impl ExprArena {
         let content = self.constant(Constant::rational(num, den)?);
         let inverse = self.constant(Constant::rational(den, num)?);
         let primitive: Vec<ExprId> = cleared.iter().map(|&t| self.times(inverse, t)).collect();
+        // A product past `i64` folds to a float: not exact, so no primitive part.
+        for &t in &primitive {
+            if matches!(self.split_coefficient(t).0, Constant::Float(_)) {
+                return None;
+            }
+        }
         let primitive = self.sum(&primitive);
         let minus_one = self.int(-1);
         let d_inverse = self.pow(d, minus_one);
@@ -329,30 +346,15 @@ impl ExprArena {
             return None;
         };
         let terms = terms.to_vec();
-        let mut divisors: Factors = Vec::new();
-        for &t in &terms {
-            let (_, factors) = self.monomial(t)?;
-            for (b, e) in factors.into_iter().filter(|(_, e)| *e < 0) {
-                match divisors.iter_mut().find(|(d, _)| *d == b) {
-                    Some((_, k)) => *k = (*k).max(-e),
-                    None => divisors.push((b, -e)),
-                }
-            }
-        }
-        if divisors.is_empty() {
+        let d = self.divisors_of(&terms)?;
+        let one = self.int(1);
+        if d == one {
             return None;
         }
-        let divisors: Vec<ExprId> = (divisors.into_iter())
-            .map(|(b, k)| {
-                let k = self.int(k);
-                self.pow(b, k)
-            })
-            .collect();
-        let d = self.product(&divisors);
         let cleared: Vec<ExprId> = terms.iter().map(|&t| self.times(d, t)).collect();
         let cleared = self.sum(&cleared);
         let power = self.pow(cleared, exponent);
-        let minus_n = self.int(-n);
+        let minus_n = self.int(n.checked_neg()?);
         let outside = self.pow(d, minus_n);
         Some(self.times(outside, power))
     }
