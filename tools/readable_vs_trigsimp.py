@@ -66,8 +66,8 @@ def trigsimp_length(text, seconds):
     worker.join(seconds)
     if worker.is_alive():
         worker.terminate()
-        return None
-    return len(out.get()) if not out.empty() else None
+        return f"trigsimp past {seconds} s"
+    return len(out.get()) if not out.empty() else "SymPy failed on it"
 
 
 def main():
@@ -88,9 +88,9 @@ def main():
                 print(f"{model} {name}: skipped, {ours} characters (--most {args.most})")
                 continue
             theirs = trigsimp_length(text, args.seconds)
-            if theirs is None:
+            if isinstance(theirs, str):
                 skipped += 1
-                print(f"{model} {name}: skipped, trigsimp past {args.seconds} s")
+                print(f"{model} {name}: skipped, {theirs}")
                 continue
             total += 1
             ours_sum += ours
