@@ -50,13 +50,18 @@ FUNCTIONS = {"sin", "cos", "tan", "asin", "acos", "atan", "atan2", "sinh", "cosh
              "exp", "ln", "sqrt", "abs", "sign", "pi"}
 
 
-def simplify(text, out):
+def trigsimp_text(text):
+    """SymPy's `trigsimp` of an entry printed by eomgen, printed as `normal` writes it."""
     # Every name a symbol (a parameter `I` is not the imaginary unit), `ln` the logarithm.
     names = {n: sp.Symbol(n) for n in re.findall(r"[A-Za-z_][A-Za-z_0-9]*", text)
              if n not in FUNCTIONS}
     names["ln"] = sp.log
     expr = sp.parse_expr(text.replace("^", "**"), local_dict=names)
-    out.put(normal(sp.sstr(sp.trigsimp(expr))))
+    return normal(sp.sstr(sp.trigsimp(expr)))
+
+
+def simplify(text, out):
+    out.put(trigsimp_text(text))
 
 
 def trigsimp_length(text, seconds):

@@ -78,13 +78,12 @@ impl ExprArena {
         for x in [flat, collected, together, together_collected] {
             candidates.push(self.rules_composed(x, &mut lengths));
         }
-        candidates.into_iter().fold(e, |best, x| {
-            if lengths.printed(self, x) < lengths.printed(self, best) {
-                x
-            } else {
-                best
-            }
-        })
+        // The first of the shortest, `e` itself before the candidates.
+        std::iter::once(e)
+            .chain(candidates)
+            .map(|x| (lengths.printed(self, x), x))
+            .min_by_key(|&(length, _)| length)
+            .map_or(e, |(_, x)| x)
     }
 
     /// `e` rebuilt bottom up (memoised) with each sum of (rebuilt) terms made by `rule`, and
@@ -124,8 +123,9 @@ impl ExprArena {
     /// passes, so that a sum a rule builds, `C (R₁ + R₂)`, is itself ruled):
     /// - sums: [`Self::pair_squares`], [`Self::double_angles`], [`Self::factored_pairs`],
     ///   [`Self::over_common_denominator`], [`Self::over_common_divisor`], [`Self::together`];
-    /// - products: [`Self::double_angle_product`], [`Self::number_multiplied_in`], [`Self::sign_taken_out`] (last, so that it wins a
-    ///   tie: its sign then merges with the sum around it);
+    /// - products: [`Self::double_angle_product`], [`Self::number_multiplied_in`],
+    ///   [`Self::sign_taken_out`] (taken at equal length too: its sign then merges with the
+    ///   sum around it);
     /// - powers: [`Self::denominator_cleared`].
     ///
     /// `lengths` keeps the lengths met, for the next call on the same expression.
