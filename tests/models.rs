@@ -101,7 +101,7 @@ fn generated_code_equals_engine_evaluation() {
                     SymbolKind::Velocity(j) => y[n + j as usize],
                     SymbolKind::Acceleration(j) => a[j as usize],
                     SymbolKind::Time => t,
-                    SymbolKind::Auxiliary | SymbolKind::Multiplier(_) => 0.0,
+                    SymbolKind::Auxiliary | SymbolKind::Multiplier(_) | SymbolKind::Retired => 0.0,
                 };
             }
             let e = evaluator.eval(&bindings);

@@ -2,11 +2,11 @@
 //! the same generalized accelerations q̈ at random states.
 
 use crate::common;
+use crate::common::accelerations;
 
 use eomgen_symbolic::expr::SymbolKind;
 use eomgen_symbolic::expr::eval::Evaluator;
 use eomgen_symbolic::expr::print::{Printer, Syntax};
-use eomgen_symbolic::mechanics::cross_check::solve;
 use eomgen_symbolic::mechanics::{
     EquationsOfMotion, Formulation, Lagrange, MomentumBalance, SymbolicModel,
 };
@@ -18,19 +18,6 @@ fn derive(source: &str, formulation: &dyn Formulation) -> (SymbolicModel, Equati
     let mut model = SymbolicModel::from_file(&file).expect("lowers");
     let eom = formulation.derive(&mut model);
     (model, eom)
-}
-
-/// q̈ of one derivation at symbol values `bindings` (indexed by symbol id).
-fn accelerations(model: &SymbolicModel, eom: &EquationsOfMotion, bindings: &[f64]) -> Vec<f64> {
-    let roots: Vec<_> = eom
-        .mass_matrix
-        .iter()
-        .chain(&eom.forcing)
-        .copied()
-        .collect();
-    let v = Evaluator::new(&model.arena, &roots).eval(bindings);
-    let n = eom.num_dofs;
-    solve(v[..n * n].to_vec(), v[n * n..].to_vec()).expect("M is regular at the sampled states")
 }
 
 /// Largest relative difference of q̈ between Lagrange on `a` and momentum balance on `b`

@@ -13,5 +13,6 @@ mod model_parser;
 mod model_pipeline;
 mod model_units;
 mod routes;
+mod speeds;
 mod tape_value_numbering;
 mod taylor_angle_sums;

@@ -107,6 +107,14 @@ pub struct EquationsListing {
     /// The unilateral contacts (`contacts:`); left out of the JSON when there are none.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub contacts: Vec<ContactListing>,
+    /// The generalized speeds `u` (`speeds:`), in order; left out of the JSON when the state
+    /// holds the rates, whose equations are `M q̈ = F`. With speeds they are `M u̇ = F`.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub speeds: Vec<String>,
+    /// With speeds, the kinematic equations `q̇ⱼ = …` in `q`, `u` and `t`, one per
+    /// coordinate; left out of the JSON otherwise.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub kinematic_equations: Vec<String>,
 }
 
 impl EquationsListing {
@@ -163,6 +171,10 @@ impl EquationsListing {
                     }),
                 })
                 .collect(),
+            speeds: model.speeds.iter().flat_map(|s| s.names.clone()).collect(),
+            kinematic_equations: (model.speeds.iter())
+                .flat_map(|s| s.kinematic_equations.iter().map(|e| p.print(*e)))
+                .collect(),
         }
     }
 }
@@ -194,7 +206,11 @@ pub fn readable_equations(model: &mut SymbolicModel, eom: &EquationsOfMotion) ->
         each(arena, &mut contact.jacobian);
         contact.gap = arena.readable_within(contact.gap, start);
     }
+    if let Some(speeds) = &mut model.speeds {
+        each(arena, &mut speeds.kinematic_equations);
+    }
     model.kinetic = arena.readable_within(model.kinetic, start);
+
     model.potential = arena.readable_within(model.potential, start);
     EquationsOfMotion {
         num_dofs: eom.num_dofs,
@@ -203,21 +219,31 @@ pub fn readable_equations(model: &mut SymbolicModel, eom: &EquationsOfMotion) ->
     }
 }
 
-/// The equations as text: `q`, `T`, `V`, `Q`, then `M` (upper triangle) and `F` entry by
-/// entry; for a constrained model `M q'' + J^T lambda = F` and `J q'' = gamma` with the
+/// The equations as text: `q` (with generalized speeds, `u` and the kinematic equations
+/// `q̇ = W u`), `T`, `V`, `Q`, then `M` (upper triangle) and `F` entry by entry; for a constrained model `M q'' + J^T lambda = F` and `J q'' = gamma` with the
 /// non-zero entries of `J`, each `γ`, and each constraint's equation.
 pub fn equations_text(model: &SymbolicModel, eom: &EquationsOfMotion) -> String {
     let e = EquationsListing::of(model, eom, Syntax::Text);
     let n = e.coordinates.len();
     let mut s = String::new();
     let _ = writeln!(s, "q = [{}]", e.coordinates.join(", "));
+    let rate = if e.speeds.is_empty() {
+        "q''"
+    } else {
+        let _ = writeln!(s, "u = [{}]", e.speeds.join(", "));
+        let _ = writeln!(s, "q' = W(q, t) u (the kinematic equations) with");
+        for (q, k) in e.coordinates.iter().zip(&e.kinematic_equations) {
+            let _ = writeln!(s, "  {q}' = {k}");
+        }
+        "u'"
+    };
     let _ = writeln!(s, "T = {}", e.kinetic_energy);
     let _ = writeln!(s, "V = {}", e.potential_energy);
     for q in &e.generalized_forces {
         let _ = writeln!(s, "Q[{}] = {}", q.coordinate, q.expression);
     }
     if e.constraints.is_empty() {
-        let _ = writeln!(s, "M q'' = F with");
+        let _ = writeln!(s, "M {rate} = F with");
     } else {
         let names: Vec<&str> = e.constraints.iter().map(|c| c.name.as_str()).collect();
         let _ = writeln!(

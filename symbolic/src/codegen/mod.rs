@@ -57,6 +57,12 @@ fn derive(
     file: &crate::model::ModelFile,
 ) -> Result<(SymbolicModel, EquationsOfMotion), GenerateError> {
     let mut model = SymbolicModel::from_file(file).map_err(GenerateError::Diagnostics)?;
+    if let Some(first) = file.speeds.first() {
+        return Err(GenerateError::Diagnostics(vec![
+            crate::model::Diagnostic::new(first.name.location, "a model with generalized speeds is derived and printed (`eomgen equations`, `eomgen check`) but not compiled yet: simulations, analyses and exported code take the state (q, q')")
+                .with_help("to run it, remove `speeds` (the same model in the coordinates' rates)"),
+        ]));
+    }
     crate::mechanics::limit_derivation(&mut model);
     let (eom, _) = crate::mechanics::preferred_equations(&mut model);
     crate::mechanics::finish_derivation(&mut model, file).map_err(GenerateError::Diagnostics)?;
@@ -176,6 +182,8 @@ fn body(arena: &ExprArena, plan: &CsePlan, helpers: &str) -> Result<Body, String
             }
             SymbolKind::Time => quote!(__t),
             SymbolKind::Auxiliary => quote!(0.0_f64),
+            // Replaced in every expression of a model with speeds; a NaN if one were left.
+            SymbolKind::Retired => quote!(f64::NAN),
             SymbolKind::Multiplier(i) => {
                 let i = index(i as usize);
                 quote!(__lambda.get(#i).copied().unwrap_or(f64::NAN))

@@ -267,6 +267,8 @@ impl Tape {
                 SymbolKind::Time => lowering.push(Instruction::Input(Input::Time)),
                 // The generated Rust binds auxiliary symbols to 0.
                 SymbolKind::Auxiliary => lowering.constant(0.0),
+                // Replaced in every expression of a model with speeds; a NaN if one were left.
+                SymbolKind::Retired => lowering.constant(f64::NAN),
             };
             lowering.symbols.insert(s, value);
         }

@@ -144,7 +144,8 @@ impl ExprArena {
         }
     }
 
-    /// Total time derivative `d/dt expr = ∂/∂t + Σᵢ (∂/∂qᵢ q̇ᵢ + ∂/∂q̇ᵢ q̈ᵢ)` along the motion.
+    /// Total time derivative `d/dt expr = ∂/∂t + Σᵢ (∂/∂qᵢ q̇ᵢ + ∂/∂q̇ᵢ q̈ᵢ)` along the motion
+    /// (with generalized speeds, `∂/∂t + Σᵢ ∂/∂qᵢ q̇ᵢ(q, u, t) + Σᵣ ∂/∂uᵣ u̇ᵣ`).
     ///
     /// Parameters and auxiliary symbols are constant in time. Differentiating an expression
     /// that already contains accelerations `q̈` is not supported (their derivative, the jerk,
@@ -159,10 +160,10 @@ impl ExprArena {
             terms.push(dt);
         }
         let coordinates = self.coordinates.clone();
-        for [q, qd, qdd] in coordinates {
+        for (i, [q, qd, qdd]) in coordinates.into_iter().enumerate() {
             let dq = self.diff(expr, q);
             if !self.is_zero(dq) {
-                let rate = self.symbol_expr(qd);
+                let rate = self.coordinate_rate(i);
                 terms.push(self.times(dq, rate));
             }
             let dqd = self.diff(expr, qd);

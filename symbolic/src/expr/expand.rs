@@ -442,7 +442,10 @@ impl ExprArena {
         self.substitute_memo(e, values, &mut memo)
     }
 
-    fn substitute_memo(
+    /// [`Self::substitute`] with `memo` as its table of what each node became: nodes put there
+    /// beforehand are replaced by their entry (a subexpression rewritten another way), and
+    /// the table kept across calls shares the work of many roots.
+    pub fn substitute_memo(
         &mut self,
         e: ExprId,
         values: &rustc_hash::FxHashMap<super::SymbolId, ExprId>,

@@ -311,6 +311,10 @@ pub enum SymbolKind {
     /// The Lagrange multiplier (constraint force) `λ_i` of constraint `i` (holonomic first),
     /// `lambda_<constraint>`: only in event functions.
     Multiplier(u32),
+    /// A coordinate's rate `q̇ᵢ` or acceleration `q̈ᵢ` in a model whose state holds
+    /// generalized speeds ([`ExprArena::switch_to_speeds`]): replaced by the kinematic
+    /// equations in every expression of the model, so never in generated code.
+    Retired,
 }
 
 /// A named symbol.
@@ -344,6 +348,9 @@ pub struct ExprArena {
     tree_costs: Vec<u64>,
     diff_memo: FxHashMap<(ExprId, SymbolId), ExprId>,
     dt_memo: FxHashMap<ExprId, ExprId>,
+    /// With generalized speeds, `q̇ᵢ` as expressions of `q`, the speeds and `t` (the
+    /// kinematic equations), which [`Self::time_derivative`] uses; `None`: the rate symbols.
+    coordinate_rates: Option<Vec<ExprId>>,
     expand_memo: FxHashMap<ExprId, ExprId>,
     expand_time_varying_memo: FxHashMap<ExprId, ExprId>,
     expand_bounded_memo: FxHashMap<ExprId, ExprId>,
@@ -499,7 +506,60 @@ impl ExprArena {
         ids.map(|id| self.add(Node::Symbol(id)))
     }
 
-    /// `(q, q̇, q̈)` symbol ids per coordinate.
+    /// Makes the speeds `names` (one per coordinate) the state's second half: declares each
+    /// speed `uᵣ` (kind [`SymbolKind::Velocity`]) and its rate `uᵣ_dot`
+    /// ([`SymbolKind::Acceleration`]), puts them in the coordinates' triples in place of
+    /// `q̇ᵣ` and `q̈ᵣ`, which become [`SymbolKind::Retired`]; returns the old `[q̇, q̈]` and the
+    /// new `[u, u̇]` expressions per coordinate. The caller then gives the kinematic
+    /// equations ([`Self::set_coordinate_rates`]) and replaces `q̇` and `q̈` in every
+    /// expression it keeps.
+    ///
+    /// # Panics
+    /// If `names` is not one per coordinate or a name is declared already (the model checks
+    /// reject both).
+    pub fn switch_to_speeds(&mut self, names: &[String]) -> Vec<([ExprId; 2], [ExprId; 2])> {
+        assert_eq!(
+            names.len(),
+            self.coordinates.len(),
+            "one speed per coordinate"
+        );
+        let mut out = Vec::with_capacity(names.len());
+        for (i, name) in names.iter().enumerate() {
+            assert!(
+                self.symbol_id(name).is_none(),
+                "speed `{name}` declared twice"
+            );
+            let [_, qd, qdd] = self.coordinates[i];
+            for old in [qd, qdd] {
+                self.symbols[old.index()].kind = SymbolKind::Retired;
+            }
+            let u = self.declare(name, SymbolKind::Velocity(i as u32));
+            let ud = self.declare(&format!("{name}_dot"), SymbolKind::Acceleration(i as u32));
+            self.coordinates[i][1] = u;
+            self.coordinates[i][2] = ud;
+            let old = [qd, qdd].map(|s| self.symbol_expr(s));
+            out.push((old, [u, ud].map(|s| self.symbol_expr(s))));
+        }
+        self.dt_memo.clear();
+        out
+    }
+
+    /// The kinematic equations `q̇ᵢ = rates[i]` of a model whose state holds generalized
+    /// speeds ([`Self::switch_to_speeds`]), for [`Self::time_derivative`].
+    pub fn set_coordinate_rates(&mut self, rates: Vec<ExprId>) {
+        self.coordinate_rates = Some(rates);
+        self.dt_memo.clear();
+    }
+
+    /// `q̇ᵢ`: the rate symbol, or with generalized speeds the kinematic equation's right side.
+    pub fn coordinate_rate(&mut self, i: usize) -> ExprId {
+        match &self.coordinate_rates {
+            Some(rates) => rates[i],
+            None => self.symbol_expr(self.coordinates[i][1]),
+        }
+    }
+
+    /// `(q, q̇, q̈)` symbol ids per coordinate (with generalized speeds, `(q, u, u̇)`).
     pub fn coordinates(&self) -> &[[SymbolId; 3]] {
         &self.coordinates
     }

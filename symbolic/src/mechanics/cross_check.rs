@@ -549,7 +549,7 @@ fn sample_states(
     // Power balance: d(T + V)/dt along the motion against Σ Qᵢ q̇ᵢ.
     let energy = model.arena.plus(model.kinetic, model.potential);
     let de_dt = model.arena.time_derivative(energy);
-    let rates: Vec<ExprId> = (0..n).map(|i| model.coordinates[i][1]).collect();
+    let rates: Vec<ExprId> = (0..n).map(|i| model.arena.coordinate_rate(i)).collect();
     let power_terms: Vec<ExprId> = (0..n)
         .map(|i| model.arena.times(model.generalized_forces[i], rates[i]))
         .collect();

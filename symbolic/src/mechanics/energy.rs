@@ -151,7 +151,7 @@ impl Formulation for EnergyRate {
 
     fn derive(&self, model: &mut SymbolicModel) -> EquationsOfMotion {
         let symbols = [model.coordinate_symbols(0)];
-        let rate = model.coordinates[0][1];
+        let rate = model.arena.coordinate_rate(0);
         let arena = &mut model.arena;
         let energy = arena.plus(model.kinetic, model.potential);
         let de_dt = arena.time_derivative(energy);
@@ -168,7 +168,7 @@ impl Formulation for PowerRoute {
 
     fn derive(&self, model: &mut SymbolicModel) -> EquationsOfMotion {
         let symbols = [model.coordinate_symbols(0)];
-        let rate = model.coordinates[0][1];
+        let rate = model.arena.coordinate_rate(0);
         let points: Vec<Vec<ExprId>> = model.points.iter().map(|(_, r)| r.clone()).collect();
         let bodies = model.bodies.clone();
         let loads = model.loads.clone();

@@ -40,6 +40,11 @@ impl Formulation for Lagrange {
     }
 
     fn derive(&self, model: &mut SymbolicModel) -> EquationsOfMotion {
+        // In generalized speeds: the equations derived in the rates before the switch,
+        // carried into the speeds (`super::speeds`).
+        if let Some(speeds) = &model.speeds {
+            return speeds.lagrange.clone();
+        }
         let n = model.num_dofs();
         let (mass_matrix, inertial, applied) = parts(model);
         let (mass_matrix, forcing) =

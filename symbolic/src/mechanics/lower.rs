@@ -201,6 +201,10 @@ pub struct SymbolicModel {
     pub events: Vec<EventInfo>,
     /// The file's `equilibria:`, in file order.
     pub equilibria: Vec<Equilibrium>,
+    /// With `speeds:`, the generalized speeds: the state is `(q, u)`, the coordinates'
+    /// triples hold `(q, u, u̇)`, and every expression above is in them
+    /// ([`super::speeds`]); `None`: the state is `(q, q̇)`.
+    pub speeds: Option<super::speeds::Speeds>,
     /// The file's `checks:` reference results, as the model's description keeps them.
     pub checks: eomgen_description::checks::Checks,
     /// The file's `floquet:` references, as the model's description keeps them.
@@ -375,6 +379,8 @@ struct Lowering<'f> {
     frames: Frames,
     /// The bodies, once lowered, for the elements.
     bodies: Vec<BodyInfo>,
+    /// The generalized speeds by name, as their definitions in the rates (`speeds:`).
+    speeds: FxHashMap<String, ExprId>,
 }
 
 impl<'f> Lowering<'f> {
@@ -389,6 +395,7 @@ impl<'f> Lowering<'f> {
             locals: Vec::new(),
             frames: Frames::default(),
             bodies: Vec::new(),
+            speeds: FxHashMap::default(),
         }
     }
 
@@ -420,6 +427,14 @@ impl<'f> Lowering<'f> {
         self.frames = self.frames_with_rates();
         let points = point::lower(&file.points, &mut self);
         self.points = points.clone();
+        // The speeds' definitions, which the expressions below may name.
+        let speed_definitions: Vec<ExprId> = (file.speeds.iter())
+            .map(|sp| {
+                let d = self.expr(&sp.value);
+                self.speeds.insert(sp.name.value.clone(), d);
+                d
+            })
+            .collect();
         let dimension = file.dimension.unwrap_or(2);
 
         let mut terms = Terms {
@@ -503,10 +518,11 @@ impl<'f> Lowering<'f> {
 
         let (checks, outputs) = self.described_checks_and_outputs();
 
+        let initial_speeds = self.initial_speeds();
         if !self.errors.is_empty() {
             return Err(self.errors);
         }
-        Ok(SymbolicModel {
+        let model = SymbolicModel {
             arena: self.arena,
             name: file.name.value.clone(),
             description: file.description.clone(),
@@ -553,7 +569,32 @@ impl<'f> Lowering<'f> {
                 .iter()
                 .map(FloquetReference::describe)
                 .collect(),
-        })
+            speeds: None,
+        };
+        if file.speeds.is_empty() {
+            return Ok(model);
+        }
+        super::speeds::switch(model, &speed_definitions, initial_speeds, file)
+    }
+
+    /// The initial speeds `initial:` gives (0 for one it does not give), or `None` if it
+    /// gives none (the speeds then start from the initial rates).
+    fn initial_speeds(&mut self) -> Option<Vec<ExprId>> {
+        let file = self.file;
+        let given: Vec<(usize, &crate::model::ast::Expr)> = (file.initial.iter())
+            .filter_map(|(k, v)| {
+                let r = file.speeds.iter().position(|s| s.name.value == k.value)?;
+                Some((r, v))
+            })
+            .collect();
+        if given.is_empty() {
+            return None;
+        }
+        let mut u0 = vec![self.arena.int(0); file.speeds.len()];
+        for (r, v) in given {
+            u0[r] = self.expr(v);
+        }
+        Some(u0)
     }
 
     /// The contacts with each change of support's values derived

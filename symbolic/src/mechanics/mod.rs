@@ -18,6 +18,7 @@ mod mass;
 mod momentum;
 mod numeric;
 mod preferred;
+mod speeds;
 
 pub use balances::{HandEquations, UserBalances};
 pub use constraints::{ConstraintEquations, linear_in_rates, redundant_rows};
@@ -32,6 +33,7 @@ pub use lower::{
 pub use mass::mass_matrix_diagnostics;
 pub use momentum::MomentumBalance;
 pub use preferred::{preferred_equations, preferred_formulation};
+pub use speeds::Speeds;
 
 use crate::expr::ExprId;
 

@@ -297,6 +297,10 @@ impl Formulation for MomentumBalance {
     /// Never; for a model where [`MomentumBalance::applies_to`] is false a written `kinetic:`
     /// is ignored, so callers check it first.
     fn derive(&self, model: &mut SymbolicModel) -> EquationsOfMotion {
+        // In generalized speeds: Kane's equations, on the partial velocities in the speeds.
+        if model.speeds.is_some() {
+            return super::speeds::kane(model);
+        }
         let n = model.num_dofs();
         let symbols: Vec<_> = (0..n).map(|i| model.coordinate_symbols(i)).collect();
         let time = model.time_symbol();

@@ -30,6 +30,7 @@ pub mod interaction;
 pub mod nonholonomic;
 pub mod point;
 pub mod shape;
+pub mod speed;
 pub mod spring;
 pub mod support;
 pub mod torque;

@@ -12,6 +12,7 @@ pub use super::elements::force::Force;
 pub use super::elements::interaction::{INTERACTION_NAMES, Interaction};
 pub use super::elements::nonholonomic::RollingContact;
 pub use super::elements::point::{Point, RelativePosition, WheelContact};
+pub use super::elements::speed::Speed;
 pub use super::elements::spring::Spring;
 pub use super::elements::torque::{Torque, TorqueValue};
 // The `checks:` and `floquet:` types live in `checks.rs`; they are named here too, where
@@ -293,6 +294,9 @@ pub struct ModelFile {
     pub interactions: Vec<Interaction>,
     /// `outputs:` — named expressions of the state, in file order.
     pub outputs: Vec<OutputDef>,
+    /// `speeds:` — generalized speeds, one per coordinate, in file order (empty: the state
+    /// holds the coordinates' rates).
+    pub speeds: Vec<Speed>,
     /// `initial:` by coordinate or rate name (`theta1`, `theta1_dot`); expressions of the
     /// parameters.
     pub initial: Vec<(Located<String>, Expr)>,

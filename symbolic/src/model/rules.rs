@@ -66,6 +66,7 @@ pub(crate) fn check_parts(
     checker.reference_checks();
     checker.floquet_references();
     checker.constraints();
+    checker.speeds();
     for spring in &file.springs {
         spring.rules(&mut checker);
     }
@@ -136,12 +137,14 @@ struct Checker<'f> {
     sets: NameSets,
 }
 
-/// Parameter, coordinate, rate, acceleration and multiplier names, hashed.
+/// Parameter, coordinate, rate, speed, acceleration and multiplier names, hashed.
 #[derive(Default)]
 struct NameSets {
     params: FxHashSet<String>,
     coords: FxHashSet<String>,
     rates: FxHashSet<String>,
+    /// Generalized speeds (`speeds:`), which read like rates.
+    speeds: FxHashSet<String>,
     accelerations: FxHashSet<String>,
     multipliers: FxHashSet<String>,
 }
@@ -182,6 +185,7 @@ impl<'f> Checker<'f> {
             params: owned(&checker.params),
             coords: owned(&checker.coords),
             rates: checker.rates.iter().cloned().collect(),
+            speeds: file.speeds.iter().map(|s| s.name.value.clone()).collect(),
             accelerations: checker.accelerations.iter().cloned().collect(),
             multipliers: checker.multipliers.iter().cloned().collect(),
         };

@@ -40,6 +40,9 @@ impl Lowering<'_> {
                 {
                     self.angular_velocities[name]
                 }
+                _ if self.arena.symbol_id(name).is_none() && self.speeds.contains_key(name) => {
+                    self.speeds[name]
+                }
                 _ => match self.arena.symbol_id(name) {
                     Some(s)
                         if self.allow_accelerations

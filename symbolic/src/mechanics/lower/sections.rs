@@ -183,7 +183,7 @@ impl Lowering<'_> {
                 .position(|c| name.value.strip_suffix("_dot") == Some(c.as_str()))
             {
                 initial_qdot[i] = e;
-            } else {
+            } else if !self.speeds.contains_key(&name.value) {
                 self.errors.push(Diagnostic::new(
                     name.location,
                     format!("`{}` is neither a coordinate nor a rate", name.value),

@@ -78,7 +78,7 @@ impl Checker<'_> {
             }
             let is_param = n == "pi" || self.sets.params.contains(n);
             let is_coord = self.sets.coords.contains(n);
-            let is_rate = self.sets.rates.contains(n);
+            let is_rate = self.sets.rates.contains(n) || self.sets.speeds.contains(n);
             let is_acceleration =
                 depends >= Depends::Acceleration && self.sets.accelerations.contains(n);
             let is_multiplier = depends >= Depends::Event && self.sets.multipliers.contains(n);

@@ -65,6 +65,78 @@ impl Checker<'_> {
         }
     }
 
+    // Rule (`speeds:`): one generalized speed per coordinate, each read where the rates may
+    // be; `initial:` gives the speeds or the rates, not both. The equations in speeds are
+    // derived for holonomic systems without contacts (Kane and Levinson, ch. 6, for the
+    // rest: constraints, contacts, balances and hand-written equations in speeds are not
+    // supported).
+    pub(super) fn speeds(&mut self) {
+        let file = self.file;
+        let Some(first) = file.speeds.first() else {
+            return;
+        };
+        for s in &file.speeds {
+            s.rules(self);
+        }
+        let (n, p) = (file.coordinates.len(), file.speeds.len());
+        if n != p && !self.incomplete.has_section("coordinates") {
+            self.error(
+                Diagnostic::new(first.name.location, format!("the model has {n} coordinate{} but {p} speed{}: `speeds` gives one per coordinate", if n == 1 { "" } else { "s" }, if p == 1 { "" } else { "s" }))
+                    .with_help("each speed is a combination of the rates, such as `w1: omega_B_x`; together they must determine every rate"),
+            );
+        }
+        let unsupported = [
+            (
+                !file.constraint_names().is_empty(),
+                "constraints (including a frame's Euler parameters)",
+            ),
+            (
+                !file.nonholonomic_names().is_empty(),
+                "non-holonomic constraints",
+            ),
+            (!file.contacts.is_empty(), "contacts"),
+            (!file.balances.is_empty(), "balances"),
+            (
+                !file.checks.equations_of_motion.is_empty(),
+                "equations of motion written by hand",
+            ),
+        ];
+        for (_, what) in unsupported.iter().filter(|(has, _)| *has) {
+            self.error(
+                Diagnostic::new(
+                    first.name.location,
+                    format!("generalized speeds are not supported in a model with {what}"),
+                )
+                .with_help("write the model in the coordinates' rates (remove `speeds`)"),
+            );
+        }
+        let rates: Vec<&Located<String>> = (file.initial.iter().map(|(k, _)| k))
+            .filter(|k| self.sets.rates.contains(k.value.as_str()))
+            .collect();
+        let speeds = file
+            .initial
+            .iter()
+            .find(|(k, _)| self.sets.speeds.contains(k.value.as_str()));
+        if let (Some(rate), Some((speed, _))) = (rates.first(), speeds) {
+            self.error(
+                Diagnostic::new(rate.location, format!("`initial` gives the rate `{}` and the speed `{}`: give the speeds or the rates, not both", rate.value, speed.value))
+                    .with_help("with `speeds`, the initial state is the coordinates and the speeds (the speeds not given start at 0)"),
+            );
+        }
+        for q in &file.equilibria {
+            if let Some((k, _)) = q
+                .values
+                .iter()
+                .find(|(k, _)| self.sets.rates.contains(k.value.as_str()))
+            {
+                self.error(
+                    Diagnostic::new(k.location, format!("equilibrium `{}` holds the rate `{}`, but the model's state holds speeds", q.name.value, k.value))
+                        .with_help("an equilibrium of a model with `speeds` gives coordinates only"),
+                );
+            }
+        }
+    }
+
     // Rule: equations of motion written by hand (`checks: equations_of_motion`) are one per
     // coordinate and use parameters, coordinates, rates, accelerations and `t`.
     pub(super) fn hand_equations(&mut self) {

@@ -4,7 +4,7 @@
 use super::*;
 
 impl Checker<'_> {
-    // Rule: parameters, coordinates, points and bodies have distinct names, none of which is
+    // Rule: parameters, coordinates, speeds, points and bodies have distinct names, none of which is
     // `t`, `pi` or a function name, or ends in `_dot` / `_ddot` (those spell rates and
     // accelerations of coordinates). Parameters and coordinates are Rust names in generated
     // code (fields and locals, a keyword as `r#type`), so none is one of the keywords that
@@ -33,6 +33,7 @@ impl Checker<'_> {
             .iter()
             .map(|p| (&p.name, "parameter"))
             .chain(file.coordinates.iter().map(|c| (&c.name, "coordinate")))
+            .chain(file.speeds.iter().map(|s| (&s.name, "speed")))
             .chain(file.points.iter().map(|p| (&p.name, "point")))
             .chain(file.bodies.iter().map(|b| (&b.name, "body")));
         for (name, kind) in named {
@@ -50,7 +51,9 @@ impl Checker<'_> {
                     )
                     .with_help("choose another name"),
                 );
-            } else if matches!(kind, "parameter" | "coordinate") && UNRAW_KEYWORDS.contains(&n) {
+            } else if matches!(kind, "parameter" | "coordinate" | "speed")
+                && UNRAW_KEYWORDS.contains(&n)
+            {
                 self.error(
                     Diagnostic::new(
                         name.location,
@@ -80,7 +83,7 @@ impl Checker<'_> {
                         name.location,
                         format!("duplicate name `{n}`: already a {first_kind} at {first}"),
                     )
-                    .with_help("parameters, coordinates, points and bodies share one namespace; rename one"),
+                    .with_help("parameters, coordinates, speeds, points and bodies share one namespace; rename one"),
                 );
             } else {
                 seen.insert(n, (name.location, kind));

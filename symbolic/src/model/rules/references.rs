@@ -177,6 +177,7 @@ impl Checker<'_> {
             let base = n.strip_suffix("_dot").unwrap_or(n);
             if self.sets.coords.contains(n)
                 || self.sets.rates.contains(n)
+                || self.sets.speeds.contains(n)
                 || self.incomplete.has_name(base)
                 || coordinates_lost
             {
@@ -431,6 +432,7 @@ impl Checker<'_> {
                 || n == "energy"
                 || self.sets.coords.contains(n)
                 || self.sets.rates.contains(n)
+                || self.sets.speeds.contains(n)
             {
                 self.error(
                     Diagnostic::new(

@@ -63,6 +63,7 @@ pub const TOP_LEVEL_KEYS: &[&str] = &[
     "units",
     "parameters",
     "coordinates",
+    "speeds",
     "kinetic",
     "potential",
     "generalized_forces",

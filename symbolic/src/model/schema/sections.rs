@@ -7,7 +7,7 @@ use super::write::{Edits, NotRewritten, Rewrite, Writer, scalar};
 use super::*;
 use crate::model::elements::{
     body, constraint, contact, damper, energy, force, frame, gravity, interaction, nonholonomic,
-    point, shape, spring, torque,
+    point, shape, speed, spring, torque,
 };
 
 /// How one top-level key of a model file is read, and written.
@@ -95,6 +95,12 @@ const SECTIONS: &[Section] = &[
             }
         }),
         write: |w, file| w.write_coordinates(file),
+    },
+    Section {
+        key: speed::KEY,
+        read: |cx, n, file| file.speeds = speed::read(cx, n),
+        missing: None,
+        write: |w, file| speed::write(w, &file.speeds),
     },
     Section {
         key: energy::KINETIC,
@@ -318,6 +324,7 @@ impl Ctx<'_> {
             torques: Vec::new(),
             interactions: Vec::new(),
             outputs: Vec::new(),
+            speeds: Vec::new(),
             initial: Vec::new(),
             draw: Draw::default(),
             dimension: None,

@@ -1,0 +1,540 @@
+//! Generalized speeds (`speeds:`): a lowered model's state switched from `(q, q̇)` to
+//! `(q, u)`, Kane's equations in `u`, and Lagrange's equations carried into `u` for their
+//! cross-check (T. R. Kane, D. A. Levinson, *Dynamics: Theory and Applications*,
+//! McGraw-Hill, 1985, §2.12, §§6.1–6.3).
+//!
+//! The file defines each speed linear in the rates, `u = Y(q, t) q̇ + Z(q, t)`, so that the
+//! kinematic equations are
+//!
+//! ```text
+//! q̇ = W (u − Z),   W = Y⁻¹ = adj(Y) / det(Y)
+//! ```
+//!
+//! with the determinant and the adjugate multiplied out. A velocity `v = A(q, t) q̇ + b(q, t)`
+//! becomes `v = Σᵣ Vᵣ uᵣ + (b − Σᵣ Vᵣ Zᵣ)` with the partial velocities
+//! `Vᵣ = (Σⱼ Aⱼ adj(Y)ⱼᵣ) / det(Y)`, the numerator multiplied out before the division: where
+//! `A` is a row of `Y` (a body's angular velocity when its components are the speeds), the
+//! numerator is `det(Y)` or 0 term by term (`Y adj(Y) = det(Y) I` holds as an identity of
+//! polynomials in the entries), so the partial velocity is exactly 1 or 0. Where `det(Y)` is
+//! a product (`cos θ` for Euler angles), the division is exact wherever the quotient has no
+//! such factor: a point of a body turning with the speeds moves at `ω × r` without `1/cos θ`.
+//!
+//! Kane's equations are then, with `a` and `α` the time derivatives of `v` and `ω` along the
+//! kinematic equations (linear in `u̇`),
+//!
+//! ```text
+//! Σ_bodies m Vᵣ·(a − g) + Ωᵣ·(I α + ω × I ω) = Σ_loads Fᵣ,   r = 1 … n
+//! ```
+//!
+//! and Lagrange's equations `M_q q̈ = F_q` (derived before the switch) carry into
+//! `Wᵀ M_q W u̇ = Wᵀ (F_q − M_q Ẇ (u − Z) − M_q W Ż)`, which the checks compare.
+
+use rustc_hash::FxHashMap;
+
+use super::frames::{Vector3, cross, tensor_times};
+use super::lower::LoadInfo;
+use super::momentum::{LoadForces, dot, linear_in_accelerations, load_forces};
+use super::{EquationsOfMotion, Formulation, Lagrange, SymbolicModel};
+use crate::expr::{ExprArena, ExprId, Node, SymbolId};
+use crate::model::diagnostic::Diagnostic;
+use crate::model::file::ModelFile;
+
+/// What a model with generalized speeds keeps of them ([`SymbolicModel::speeds`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Speeds {
+    /// The speeds' names, in file order (one per coordinate).
+    pub names: Vec<String>,
+    /// The kinematic equations: `q̇ⱼ` as an expression of `q`, `u` and `t`, per coordinate.
+    pub kinematic_equations: Vec<ExprId>,
+    /// `W = Y⁻¹`, `n × n` row-major: `q̇ = W (u − Z)`.
+    pub inverse: Vec<ExprId>,
+    /// `Z(q, t)`, per speed: its value with every rate 0.
+    pub offsets: Vec<ExprId>,
+    /// Lagrange's equations carried into the speeds.
+    pub lagrange: EquationsOfMotion,
+    /// `det(Y)`, multiplied out.
+    determinant: ExprId,
+    /// `adj(Y)`, `n × n` row-major, each entry multiplied out.
+    adjugate: Vec<ExprId>,
+}
+
+/// Switches `model`'s state to the speeds of `file`, whose definitions (in `q`, `q̇`, `t`, as
+/// lowered) are `definitions` and whose `initial:` values (where the file gives speeds rather
+/// than rates) are `initial`.
+///
+/// # Errors
+/// A definition that is not linear in the rates, or speeds that do not determine the rates
+/// (`det(∂u/∂q̇) = 0` identically), each located in `file`.
+pub(crate) fn switch(
+    mut model: SymbolicModel,
+    definitions: &[ExprId],
+    initial: Option<Vec<ExprId>>,
+    file: &ModelFile,
+) -> Result<SymbolicModel, Vec<Diagnostic>> {
+    let n = model.num_dofs();
+    let lagrange_q = Lagrange.derive(&mut model);
+    let old: Vec<[SymbolId; 3]> = (0..n).map(|i| model.coordinate_symbols(i)).collect();
+    let arena = &mut model.arena;
+    let zero = arena.int(0);
+    let at_rest: FxHashMap<SymbolId, ExprId> = old.iter().map(|s| (s[1], zero)).collect();
+    let mut y = Vec::with_capacity(n * n);
+    let mut offsets = Vec::with_capacity(n);
+    let mut errors = Vec::new();
+    for (r, &d) in definitions.iter().enumerate() {
+        for s in &old {
+            let c = arena.diff(d, s[1]);
+            let nonlinear = old.iter().any(|t| {
+                let cc = arena.diff(c, t[1]);
+                !arena.is_zero(cc)
+            });
+            if nonlinear {
+                let speed = &file.speeds[r];
+                errors.push(
+                    Diagnostic::new(speed.value.location, format!("speed `{}` is not linear in the rates", speed.name.value))
+                        .with_help("a generalized speed is a combination of the rates with coefficients in the coordinates and `t`, such as `omega_B_x` or `theta1_dot + theta2_dot`"),
+                );
+            }
+            y.push(c);
+        }
+        offsets.push(arena.substitute(d, &at_rest));
+    }
+    if !errors.is_empty() {
+        return Err(errors);
+    }
+    let (determinant, adjugate) = determinant_and_adjugate(arena, &y, n);
+    if arena.is_zero(determinant) {
+        let first = &file.speeds[0];
+        return Err(vec![
+            Diagnostic::new(first.name.location, "the speeds do not determine the rates: the determinant of their coefficients in the rates is identically 0")
+                .with_help("choose speeds that are independent combinations of the rates, one per coordinate"),
+        ]);
+    }
+    let inverse: Vec<ExprId> = adjugate
+        .iter()
+        .map(|&a| over_determinant(arena, a, determinant))
+        .collect();
+
+    let pairs = arena.switch_to_speeds(
+        &file
+            .speeds
+            .iter()
+            .map(|s| s.name.value.clone())
+            .collect::<Vec<_>>(),
+    );
+    let u: Vec<ExprId> = pairs.iter().map(|(_, [u, _])| *u).collect();
+    for (c, (_, new)) in model.coordinates.iter_mut().zip(&pairs) {
+        c[1] = new[0];
+        c[2] = new[1];
+    }
+    let relative: Vec<ExprId> = u
+        .iter()
+        .zip(&offsets)
+        .map(|(&u, &z)| arena.minus(u, z))
+        .collect();
+    let rates: Vec<ExprId> = (0..n)
+        .map(|j| {
+            let terms: Vec<ExprId> = (0..n)
+                .map(|r| arena.times(inverse[j * n + r], relative[r]))
+                .collect();
+            arena.sum(&terms)
+        })
+        .collect();
+    arena.set_coordinate_rates(rates.clone());
+    let accelerations: Vec<ExprId> = rates.iter().map(|&r| arena.time_derivative(r)).collect();
+    let speeds = Speeds {
+        names: file.speeds.iter().map(|s| s.name.value.clone()).collect(),
+        kinematic_equations: rates,
+        inverse,
+        offsets,
+        lagrange: lagrange_q.clone(),
+        determinant,
+        adjugate,
+    };
+
+    // Every expression of the model in the speeds: `q̇` and `q̈` replaced, the definitions
+    // and the bodies' angular velocities by their forms in `u` (partial velocities divided
+    // out exactly).
+    let mut values: FxHashMap<SymbolId, ExprId> = FxHashMap::default();
+    for (j, (old, _)) in pairs.iter().enumerate() {
+        for (k, &e) in old.iter().enumerate() {
+            let Node::Symbol(s) = *arena.node(e) else {
+                unreachable!("a coordinate's rate is a symbol")
+            };
+            values.insert(s, [speeds.kinematic_equations[j], accelerations[j]][k]);
+        }
+    }
+    let mut memo: FxHashMap<ExprId, ExprId> = FxHashMap::default();
+    for (r, &d) in definitions.iter().enumerate() {
+        memo.insert(d, u[r]);
+    }
+    for body in &model.bodies {
+        if let Some(spatial) = &body.spatial {
+            for &c in &spatial.angular_velocity {
+                if let std::collections::hash_map::Entry::Vacant(entry) = memo.entry(c) {
+                    let partials: Vec<ExprId> = old.iter().map(|s| arena.diff(c, s[1])).collect();
+                    let rest = arena.substitute(c, &at_rest);
+                    entry.insert(speeds.velocity(arena, &partials, rest));
+                }
+            }
+        }
+    }
+    let mut sub = |arena: &mut ExprArena, e: ExprId| arena.substitute_memo(e, &values, &mut memo);
+    model.kinetic = sub(arena, model.kinetic);
+    model.potential = sub(arena, model.potential);
+    for q in model
+        .generalized_forces
+        .iter_mut()
+        .chain(model.written_forces.iter_mut())
+    {
+        *q = sub(arena, *q);
+    }
+    for body in &mut model.bodies {
+        if let Some(spatial) = &mut body.spatial {
+            spatial.angular_velocity = spatial.angular_velocity.map(|c| sub(arena, c));
+        }
+    }
+    for load in &mut model.loads {
+        match load {
+            LoadInfo::Force { vector, .. } => vector.iter_mut().for_each(|c| *c = sub(arena, *c)),
+            LoadInfo::Torque { value, .. } => *value = sub(arena, *value),
+            LoadInfo::SpatialTorque { vector, .. } => *vector = vector.map(|c| sub(arena, c)),
+            LoadInfo::Spring { stiffness, .. } => *stiffness = sub(arena, *stiffness),
+            LoadInfo::Damper { coefficient, .. } => *coefficient = sub(arena, *coefficient),
+        }
+    }
+    for event in &mut model.events {
+        event.function = sub(arena, event.function);
+    }
+    let lagrange_forcing: Vec<ExprId> = lagrange_q.forcing.iter().map(|&f| sub(arena, f)).collect();
+    model.initial_qdot = match initial {
+        Some(u0) => u0,
+        None => {
+            let mut start: FxHashMap<SymbolId, ExprId> = FxHashMap::default();
+            for (j, s) in old.iter().enumerate() {
+                start.insert(s[0], model.initial_q[j]);
+                start.insert(s[1], model.initial_qdot[j]);
+            }
+            definitions
+                .iter()
+                .map(|&d| arena.substitute(d, &start))
+                .collect()
+        }
+    };
+    let lagrange = speeds.carried(
+        arena,
+        &lagrange_q.mass_matrix,
+        &lagrange_forcing,
+        &accelerations,
+    );
+    model.speeds = Some(Speeds { lagrange, ..speeds });
+    Ok(model)
+}
+
+impl Speeds {
+    /// `v = Σⱼ Aⱼ q̇ⱼ + b` in the speeds, `partials` the `Aⱼ` and `rest` the `b` (functions of
+    /// `q` and `t`): `Σᵣ Vᵣ uᵣ + b − Σᵣ Vᵣ Zᵣ`, each `Vᵣ` divided out exactly where it can be
+    /// (see the module docs).
+    fn velocity(&self, arena: &mut ExprArena, partials: &[ExprId], rest: ExprId) -> ExprId {
+        let n = partials.len();
+        let mut terms = vec![rest];
+        for r in 0..n {
+            let mut numerator = Vec::new();
+            for (j, &a) in partials.iter().enumerate() {
+                if !arena.is_zero(a) {
+                    numerator.push(arena.times(a, self.adjugate[j * n + r]));
+                }
+            }
+            if numerator.is_empty() {
+                continue;
+            }
+            let sum = arena.sum(&numerator);
+            let expanded = arena.expand(sum);
+            let v = over_determinant(arena, expanded, self.determinant);
+            if arena.is_zero(v) {
+                continue;
+            }
+            let u = arena.symbol_expr(arena.coordinates()[r][1]);
+            let relative = arena.minus(u, self.offsets[r]);
+            terms.push(arena.times(v, relative));
+        }
+        arena.sum(&terms)
+    }
+
+    /// Lagrange's `M_q q̈ = F_q` (`forcing` already in the speeds) carried into them:
+    /// `Wᵀ M_q W u̇ = Wᵀ (F_q − M_q q̈₀)`, `q̈₀` the accelerations at `u̇ = 0`.
+    fn carried(
+        &self,
+        arena: &mut ExprArena,
+        mass: &[ExprId],
+        forcing: &[ExprId],
+        accelerations: &[ExprId],
+    ) -> EquationsOfMotion {
+        let n = forcing.len();
+        let zero = arena.int(0);
+        let rest: FxHashMap<SymbolId, ExprId> =
+            arena.coordinates().iter().map(|s| (s[2], zero)).collect();
+        let at_rest: Vec<ExprId> = accelerations
+            .iter()
+            .map(|&a| arena.substitute(a, &rest))
+            .collect();
+        let residual: Vec<ExprId> = (0..n)
+            .map(|i| {
+                let inertial: Vec<ExprId> = (0..n)
+                    .map(|j| arena.times(mass[i * n + j], at_rest[j]))
+                    .collect();
+                let inertial = arena.sum(&inertial);
+                arena.minus(forcing[i], inertial)
+            })
+            .collect();
+        let w = &self.inverse;
+        let mut mass_matrix = vec![zero; n * n];
+        let mut carried_forcing = vec![zero; n];
+        for r in 0..n {
+            let f: Vec<ExprId> = (0..n)
+                .map(|i| arena.times(w[i * n + r], residual[i]))
+                .collect();
+            let f = arena.sum(&f);
+            carried_forcing[r] = arena.expand_if_cheaper(f);
+            for s in r..n {
+                let mut terms = Vec::new();
+                for i in 0..n {
+                    for j in 0..n {
+                        if !arena.is_zero(mass[i * n + j]) {
+                            terms.push(arena.product(&[
+                                w[i * n + r],
+                                mass[i * n + j],
+                                w[j * n + s],
+                            ]));
+                        }
+                    }
+                }
+                let m = arena.sum(&terms);
+                let m = arena.expand_if_cheaper(m);
+                mass_matrix[r * n + s] = m;
+                mass_matrix[s * n + r] = m;
+            }
+        }
+        EquationsOfMotion {
+            num_dofs: n,
+            mass_matrix,
+            forcing: carried_forcing,
+        }
+    }
+}
+
+/// `numerator / determinant`, multiplied out where the determinant is a product of factors
+/// (so that the factors it shares with every term of the numerator cancel exactly).
+fn over_determinant(arena: &mut ExprArena, numerator: ExprId, determinant: ExprId) -> ExprId {
+    if arena.is_zero(numerator) {
+        return numerator;
+    }
+    if matches!(arena.node(determinant), Node::Add(_)) {
+        return arena.divide(numerator, determinant);
+    }
+    let q = arena.divide(numerator, determinant);
+    arena.expand(q)
+}
+
+/// `det(Y)` and `adj(Y)` (row-major, `adj(Y)ⱼᵣ` the cofactor of `Yᵣⱼ`) of the `n × n`
+/// row-major `y`, each multiplied out, by cofactor expansion along the first row of each
+/// minor with every minor computed once (by its rows and columns), skipping zero entries: the
+/// speeds' coefficient matrices are small or sparse (`n` ≤ 64 is asserted).
+fn determinant_and_adjugate(
+    arena: &mut ExprArena,
+    y: &[ExprId],
+    n: usize,
+) -> (ExprId, Vec<ExprId>) {
+    assert!(n <= 64, "at most 64 speeds");
+    let all: u64 = if n == 64 { u64::MAX } else { (1u64 << n) - 1 };
+    let mut memo: FxHashMap<(u64, u64), ExprId> = FxHashMap::default();
+    let det = minor(arena, y, n, (all, all), &mut memo);
+    let determinant = arena.expand(det);
+    let mut adjugate = vec![arena.int(0); n * n];
+    for r in 0..n {
+        for j in 0..n {
+            let m = minor(arena, y, n, (all & !(1 << r), all & !(1 << j)), &mut memo);
+            let m = if (r + j) % 2 == 1 { arena.neg(m) } else { m };
+            adjugate[j * n + r] = arena.expand(m);
+        }
+    }
+    (determinant, adjugate)
+}
+
+/// The determinant of the rows and columns of `y` in the bit sets `(rows, columns)` (as
+/// many of each), expanded along its first row.
+fn minor(
+    arena: &mut ExprArena,
+    y: &[ExprId],
+    n: usize,
+    (rows, columns): (u64, u64),
+    memo: &mut FxHashMap<(u64, u64), ExprId>,
+) -> ExprId {
+    if rows == 0 {
+        return arena.int(1);
+    }
+    if let Some(&m) = memo.get(&(rows, columns)) {
+        return m;
+    }
+    let r = rows.trailing_zeros() as usize;
+    let mut terms = Vec::new();
+    let mut sign_negative = false;
+    for c in (0..n).filter(|&c| columns & (1 << c) != 0) {
+        let entry = y[r * n + c];
+        if !arena.is_zero(entry) {
+            let sub = minor(arena, y, n, (rows & !(1 << r), columns & !(1 << c)), memo);
+            if !arena.is_zero(sub) {
+                let t = arena.times(entry, sub);
+                terms.push(if sign_negative { arena.neg(t) } else { t });
+            }
+        }
+        sign_negative = !sign_negative;
+    }
+    let m = arena.sum(&terms);
+    memo.insert((rows, columns), m);
+    m
+}
+
+/// Kane's equations in the speeds of `model` (see the module docs), `M u̇ = F`.
+///
+/// # Panics
+/// If `model` has no speeds (a programmer error: [`super::MomentumBalance`] calls it only for
+/// such a model).
+pub(crate) fn kane(model: &mut SymbolicModel) -> EquationsOfMotion {
+    let speeds = model.speeds.clone().expect("a model with speeds");
+    let n = model.num_dofs();
+    let symbols: Vec<[SymbolId; 3]> = (0..n).map(|i| model.coordinate_symbols(i)).collect();
+    let time = model.time_symbol();
+    let points: Vec<Vec<ExprId>> = model.points.iter().map(|(_, r)| r.clone()).collect();
+    let bodies = model.bodies.clone();
+    let gravity = model.gravity.clone();
+    let arena = &mut model.arena;
+    let mut residual: Vec<Vec<ExprId>> = vec![Vec::new(); n];
+    let mut velocities: FxHashMap<usize, Vec<ExprId>> = FxHashMap::default();
+    let mut velocity_of = |arena: &mut ExprArena, p: usize| -> Vec<ExprId> {
+        velocities
+            .entry(p)
+            .or_insert_with(|| {
+                points[p]
+                    .iter()
+                    .map(|&c| speeds.velocity_of_position(arena, c, &symbols, time))
+                    .collect()
+            })
+            .clone()
+    };
+    let partials = |arena: &mut ExprArena, v: &[ExprId], r: usize| -> Vec<ExprId> {
+        v.iter().map(|&c| arena.diff(c, symbols[r][1])).collect()
+    };
+    for body in &bodies {
+        // m Vᵣ·(a − g)
+        let v = velocity_of(arena, body.com);
+        let mut a: Vec<ExprId> = v.iter().map(|&c| arena.time_derivative(c)).collect();
+        if let Some(g) = &gravity {
+            a = a.iter().zip(g).map(|(&a, &g)| arena.minus(a, g)).collect();
+        }
+        for (r, terms) in residual.iter_mut().enumerate() {
+            let vr = partials(arena, &v, r);
+            let d = dot(arena, &vr, &a);
+            if !arena.is_zero(d) {
+                terms.push(arena.times(body.mass, d));
+            }
+        }
+        // Ωᵣ I α, planar
+        if let Some((inertia, angle)) = body.rotation {
+            let omega = speeds.velocity_of_position(arena, angle, &symbols, time);
+            let alpha = arena.time_derivative(omega);
+            for (r, terms) in residual.iter_mut().enumerate() {
+                let w = arena.diff(omega, symbols[r][1]);
+                if !arena.is_zero(w) {
+                    terms.push(arena.product(&[inertia, alpha, w]));
+                }
+            }
+        }
+        // Ωᵣ·(I α + ω × I ω), in the body's axes
+        if let Some(spatial) = &body.spatial {
+            let w = spatial.angular_velocity;
+            let alpha: Vector3 = w.map(|c| arena.time_derivative(c));
+            let i_alpha = tensor_times(arena, &spatial.inertia, &alpha);
+            let i_w = tensor_times(arena, &spatial.inertia, &w);
+            let gyroscopic = cross(arena, &w, &i_w);
+            let euler: Vec<ExprId> = (0..3)
+                .map(|k| arena.plus(i_alpha[k], gyroscopic[k]))
+                .collect();
+            for (r, terms) in residual.iter_mut().enumerate() {
+                let wr = partials(arena, &w, r);
+                let d = dot(arena, &wr, &euler);
+                if !arena.is_zero(d) {
+                    terms.push(d);
+                }
+            }
+        }
+    }
+    // − Σ loads: forces at points on their partial velocities, torques on the partial
+    // angular velocities, and the written potential's and forces' `Qⱼ` carried by `W`.
+    for load in &model.loads {
+        let LoadForces { forces, torque } = match load {
+            LoadInfo::SpatialTorque { body, vector } => {
+                if let Some(spatial) = &bodies[*body].spatial {
+                    for (r, terms) in residual.iter_mut().enumerate() {
+                        let wr = partials(arena, &spatial.angular_velocity, r);
+                        let power = dot(arena, vector, &wr);
+                        if !arena.is_zero(power) {
+                            terms.push(arena.neg(power));
+                        }
+                    }
+                }
+                LoadForces::default()
+            }
+            _ => load_forces(arena, &points, load),
+        };
+        for (point, f) in &forces {
+            let v = velocity_of(arena, *point);
+            for (r, terms) in residual.iter_mut().enumerate() {
+                let vr = partials(arena, &v, r);
+                let power = dot(arena, f, &vr);
+                if !arena.is_zero(power) {
+                    terms.push(arena.neg(power));
+                }
+            }
+        }
+        if let Some((angle, value)) = torque {
+            let omega = speeds.velocity_of_position(arena, angle, &symbols, time);
+            for (r, terms) in residual.iter_mut().enumerate() {
+                let w = arena.diff(omega, symbols[r][1]);
+                if !arena.is_zero(w) {
+                    let t = arena.times(value, w);
+                    terms.push(arena.neg(t));
+                }
+            }
+        }
+    }
+    for (j, s) in symbols.iter().enumerate() {
+        let dv = arena.diff(model.written_potential, s[0]);
+        let q = arena.minus(model.written_forces[j], dv);
+        if arena.is_zero(q) {
+            continue;
+        }
+        for (r, terms) in residual.iter_mut().enumerate() {
+            let w = speeds.inverse[j * n + r];
+            if !arena.is_zero(w) {
+                let t = arena.times(w, q);
+                terms.push(arena.neg(t));
+            }
+        }
+    }
+    linear_in_accelerations(arena, &residual, &symbols)
+}
+
+impl Speeds {
+    /// The time derivative of `e(q, t)` in the speeds, by [`Self::velocity`].
+    fn velocity_of_position(
+        &self,
+        arena: &mut ExprArena,
+        e: ExprId,
+        symbols: &[[SymbolId; 3]],
+        time: SymbolId,
+    ) -> ExprId {
+        let partials: Vec<ExprId> = symbols.iter().map(|s| arena.diff(e, s[0])).collect();
+        let rest = arena.diff(e, time);
+        self.velocity(arena, &partials, rest)
+    }
+}

@@ -1,0 +1,304 @@
+//! Generalized speeds (`speeds:`): Kane's equations in the speeds against closed forms
+//! (Euler's equations), against Lagrange's equations carried into the speeds, and against the
+//! same mechanism derived in its coordinates' rates; the kinematic equations against the
+//! definitions; and the model file's mistakes.
+
+use crate::common;
+use crate::common::accelerations;
+
+use eomgen_symbolic::expr::eval::Evaluator;
+use eomgen_symbolic::expr::{ExprId, SymbolKind};
+use eomgen_symbolic::mechanics::{Formulation, Lagrange, MomentumBalance, SymbolicModel};
+use rand::rngs::Xoshiro256PlusPlus;
+use rand::{RngExt, SeedableRng};
+
+const FREE_BODY: &str = include_str!("../../tests/fixtures/free_rigid_body_speeds.yaml");
+const TOP: &str = include_str!("../../tests/fixtures/heavy_top_speeds.yaml");
+
+fn lowered(source: &str) -> SymbolicModel {
+    let file = eomgen_symbolic::model::load("m.yaml", source).expect("loads");
+    SymbolicModel::from_file(&file).expect("lowers")
+}
+
+/// Symbol values (by symbol id): parameters at their defaults, coordinate `i` at `q[i]`, the
+/// second half of the state (rates, or speeds) at `v[i]`, `t`; every other symbol 0.
+fn bindings(model: &SymbolicModel, q: &[f64], v: &[f64], t: f64) -> Vec<f64> {
+    (model.arena.symbols().iter())
+        .map(|s| match s.kind {
+            SymbolKind::Parameter => (model.parameters.iter())
+                .find(|p| p.name == s.name)
+                .map_or(0.0, |p| p.default),
+            SymbolKind::Coordinate(i) => q[i as usize],
+            SymbolKind::Velocity(i) => v[i as usize],
+            SymbolKind::Time => t,
+            _ => 0.0,
+        })
+        .collect()
+}
+
+fn values(model: &SymbolicModel, roots: &[ExprId], b: &[f64]) -> Vec<f64> {
+    Evaluator::new(&model.arena, roots).eval(b)
+}
+
+fn random(rng: &mut Xoshiro256PlusPlus, n: usize, r: f64) -> Vec<f64> {
+    (0..n).map(|_| rng.random_range(-r..r)).collect()
+}
+
+fn relative(a: &[f64], b: &[f64]) -> f64 {
+    let scale = a.iter().chain(b).fold(1.0f64, |m, x| m.max(x.abs()));
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max)
+        / scale
+}
+
+/// With the body-fixed components of `ω` as speeds, a free body's Kane equations are
+/// Euler's: `M` is the diagonal of the principal moments, exactly (the parameters
+/// themselves), and `F` equals `((I2 − I3) w2 w3, (I3 − I1) w3 w1, (I1 − I2) w1 w2)` at 100
+/// random states to 1e-14 relative; Lagrange's equations carried into the speeds give the
+/// same `u̇` to 1e-12.
+#[test]
+fn a_free_body_in_body_rates_has_eulers_equations() {
+    let mut model = lowered(FREE_BODY);
+    let kane = MomentumBalance.derive(&mut model);
+    let lagrange = Lagrange.derive(&mut model);
+    let zero = model.arena.int(0);
+    let diagonal = ["I1", "I2", "I3"].map(|name| {
+        let s = model.arena.symbol_id(name).expect("a parameter");
+        model.arena.symbol_expr(s)
+    });
+    for (i, &d) in diagonal.iter().enumerate() {
+        for j in 0..3 {
+            let want = if i == j { d } else { zero };
+            assert_eq!(kane.mass(i, j), want, "M[{i},{j}]");
+        }
+    }
+    let (i1, i2, i3) = (1.0, 2.0, 3.0);
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(53);
+    for _ in 0..100 {
+        let (q, w) = (random(&mut rng, 3, 1.2), random(&mut rng, 3, 3.0));
+        let b = bindings(&model, &q, &w, 0.0);
+        let f = values(&model, &kane.forcing, &b);
+        let euler = [
+            (i2 - i3) * w[1] * w[2],
+            (i3 - i1) * w[2] * w[0],
+            (i1 - i2) * w[0] * w[1],
+        ];
+        assert!(relative(&f, &euler) < 1e-14, "{f:?} against {euler:?}");
+        let (a, c) = (
+            accelerations(&model, &kane, &b),
+            accelerations(&model, &lagrange, &b),
+        );
+        assert!(relative(&a, &c) < 1e-12, "{a:?} against {c:?}");
+    }
+}
+
+/// The heavy top in body rates: Euler's equations about the fixed point with the moment of
+/// gravity, `I1 ẇ1 = (I1 − I3) w2 w3 + m g l sin θ cos ψ`,
+/// `I1 ẇ2 = (I3 − I1) w3 w1 − m g l sin θ sin ψ`, `I3 ẇ3 = 0` (Goldstein §5.7), at 100
+/// random states (θ away from the angles' singularity at 0) to 1e-13 relative, from both
+/// derivations.
+#[test]
+fn the_heavy_top_in_body_rates_has_eulers_equations_with_gravity() {
+    let mut model = lowered(TOP);
+    let kane = MomentumBalance.derive(&mut model);
+    let lagrange = Lagrange.derive(&mut model);
+    let (m, g, l, i1, i3) = (1.0, 9.81, 0.1, 0.02, 0.01);
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(7);
+    for _ in 0..100 {
+        let q = [
+            rng.random_range(-3.0..3.0),
+            rng.random_range(0.2..2.9),
+            rng.random_range(-3.0..3.0),
+        ];
+        let w = random(&mut rng, 3, 20.0);
+        let b = bindings(&model, &q, &w, 0.0);
+        let (st, sp, cp) = (q[1].sin(), q[2].sin(), q[2].cos());
+        let want = [
+            ((i1 - i3) * w[1] * w[2] + m * g * l * st * cp) / i1,
+            ((i3 - i1) * w[2] * w[0] - m * g * l * st * sp) / i1,
+            0.0,
+        ];
+        for eom in [&kane, &lagrange] {
+            let a = accelerations(&model, eom, &b);
+            assert!(relative(&a, &want) < 1e-13, "{a:?} against {want:?}");
+        }
+    }
+}
+
+/// The kinematic equations invert the definitions: at random `(q, u)`, the body's angular
+/// velocity of the same file without `speeds:` (the derivation in the rates, whose `ω` is
+/// built from the rotations) evaluated at `q̇ = W(q) u` is `u`, to 1e-13 relative.
+#[test]
+fn the_kinematic_equations_give_back_the_speeds() {
+    for source in [FREE_BODY, TOP] {
+        let with = lowered(source);
+        let speeds = with.speeds.as_ref().expect("speeds");
+        let without = lowered(&without_speeds(source));
+        let omega = without.bodies[0]
+            .spatial
+            .as_ref()
+            .expect("a 3-D body")
+            .angular_velocity;
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(11);
+        for _ in 0..100 {
+            let q = [
+                rng.random_range(-3.0..3.0),
+                rng.random_range(0.2..1.3),
+                rng.random_range(-3.0..3.0),
+            ];
+            let u = random(&mut rng, 3, 5.0);
+            let rates = values(
+                &with,
+                &speeds.kinematic_equations,
+                &bindings(&with, &q, &u, 0.0),
+            );
+            let w = values(&without, &omega, &bindings(&without, &q, &rates, 0.0));
+            assert!(relative(&w, &u) < 1e-13, "{w:?} against {u:?}");
+        }
+    }
+}
+
+/// `source` with its `speeds:` block and the speeds' initial values left out (the same
+/// mechanism in the coordinates' rates).
+fn without_speeds(source: &str) -> String {
+    let mut out = String::new();
+    let mut in_speeds = false;
+    for line in source.lines() {
+        if line.starts_with("speeds:") {
+            in_speeds = true;
+            continue;
+        }
+        if in_speeds && line.starts_with("  ") {
+            continue;
+        }
+        in_speeds = false;
+        if line.starts_with("initial:") {
+            continue;
+        }
+        out.push_str(line);
+        out.push('\n');
+    }
+    out
+}
+
+/// A planar chain in the upper arm's rate and the elbow's (relative) rate, with the bundled
+/// double pendulum's time-dependent forearm torque: `u̇ = (θ̈₁, θ̈₂ − θ̈₁)` with `θ̈` of the
+/// bundled model derived in its own rates (momentum balance and Lagrange), at 100 random
+/// states, to 1e-12 relative, from both derivations in the speeds.
+#[test]
+fn a_chain_in_relative_rates_moves_as_in_absolute_ones() {
+    let base = common::double_pendulum_with_forearm_torque();
+    let base = strip_section(&base, "balances:");
+    let with = base.replace(
+        "coordinates:\n",
+        "speeds:\n  u1: theta1_dot\n  u2: theta2_dot - theta1_dot\ncoordinates:\n",
+    );
+    assert!(with.contains("u2: theta2_dot - theta1_dot"));
+    let mut speeds_model = lowered(&with);
+    let kane = MomentumBalance.derive(&mut speeds_model);
+    let carried = Lagrange.derive(&mut speeds_model);
+    let mut rates_model = lowered(&base);
+    let reference = Lagrange.derive(&mut rates_model);
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(19);
+    for _ in 0..100 {
+        let q = random(&mut rng, 2, 3.0);
+        let u = random(&mut rng, 2, 3.0);
+        let t = rng.random_range(0.0..5.0);
+        let qd = [u[0], u[0] + u[1]];
+        let qdd = accelerations(
+            &rates_model,
+            &reference,
+            &bindings(&rates_model, &q, &qd, t),
+        );
+        let want = [qdd[0], qdd[1] - qdd[0]];
+        for eom in [&kane, &carried] {
+            let a = accelerations(&speeds_model, eom, &bindings(&speeds_model, &q, &u, t));
+            assert!(relative(&a, &want) < 1e-12, "{a:?} against {want:?}");
+        }
+    }
+}
+
+/// `source` without the top-level section `key` (its line and the indented lines below).
+fn strip_section(source: &str, key: &str) -> String {
+    let mut out = String::new();
+    let mut inside = false;
+    for line in source.lines() {
+        if line.starts_with(key) {
+            inside = true;
+            continue;
+        }
+        if inside && (line.starts_with(' ') || line.starts_with('#')) {
+            continue;
+        }
+        inside = false;
+        out.push_str(line);
+        out.push('\n');
+    }
+    out
+}
+
+/// The messages of a file whose speeds are wrong, each at its place: nonlinear, dependent,
+/// too few, beside constraints, with both initial rates and speeds; and a model with speeds
+/// is not compiled (yet), said so rather than run in the wrong state.
+#[test]
+fn mistaken_speeds_are_located() {
+    let lowering_error = |source: &str| -> String {
+        let file = eomgen_symbolic::model::load("m.yaml", source).expect("loads");
+        let errors = SymbolicModel::from_file(&file).expect_err("an error");
+        format!(
+            "{}:{}: {}",
+            errors[0].location.line, errors[0].location.column, errors[0].message
+        )
+    };
+    let load_error = |source: &str| -> String {
+        let errors = eomgen_symbolic::model::load("m.yaml", source).expect_err("an error");
+        errors
+            .iter()
+            .map(|d| format!("{}:{}: {}", d.location.line, d.location.column, d.message))
+            .collect::<Vec<_>>()
+            .join("\n")
+    };
+    let planar = |speeds: &str, initial: &str| {
+        format!(
+            "name: p\ncoordinates: [x, y]\nspeeds: {{ {speeds} }}\nparameters: {{ m: 1 }}\npoints: {{ P: [x, y] }}\nbodies: {{ ball: {{ mass: m, at: P }} }}\ninitial: {{ {initial} }}\n"
+        )
+    };
+    let e = lowering_error(&planar("a: x_dot^2, b: y_dot", "x: 1"));
+    assert_eq!(e, "3:14: speed `a` is not linear in the rates");
+    let e = lowering_error(&planar("a: x_dot + y_dot, b: 2*x_dot + 2*y_dot", "x: 1"));
+    assert!(
+        e.starts_with("3:11: the speeds do not determine the rates"),
+        "{e}"
+    );
+    let e = load_error(&planar("a: x_dot", "x: 1"));
+    assert!(
+        e.contains("3:11: the model has 2 coordinates but 1 speed"),
+        "{e}"
+    );
+    let e = load_error(&planar("a: x_dot, b: y_dot", "x_dot: 1, a: 2"));
+    assert!(
+        e.contains("7:12: `initial` gives the rate `x_dot` and the speed `a`"),
+        "{e}"
+    );
+    let quaternion = include_str!("../../tests/fixtures/free_rigid_body_quaternion.yaml").replace(
+        "coordinates:\n",
+        "speeds: { a: e0_dot, b: e1_dot, c: e2_dot, d: e3_dot }\ncoordinates:\n",
+    );
+    let e = load_error(&quaternion);
+    assert!(
+        e.contains("generalized speeds are not supported in a model with constraints"),
+        "{e}"
+    );
+    let file = eomgen_symbolic::model::load("m.yaml", FREE_BODY).expect("loads");
+    let refused = eomgen_symbolic::codegen::generate(&file, &Default::default());
+    let Err(eomgen_symbolic::codegen::GenerateError::Diagnostics(d)) = refused else {
+        panic!("a model with speeds compiled")
+    };
+    assert!(
+        d[0].message.contains("not compiled yet"),
+        "{}",
+        d[0].message
+    );
+}
