@@ -4,7 +4,7 @@
 
 use eomgen_symbolic::codegen::{EquationsListing, equations_latex, equations_text};
 use eomgen_symbolic::expr::print::Syntax;
-use eomgen_symbolic::mechanics::{Formulation, Lagrange, MomentumBalance, SymbolicModel};
+use eomgen_symbolic::mechanics::{Formulation, Kane, Lagrange, MomentumBalance, SymbolicModel};
 use serde::Serialize;
 
 pub use eomgen_symbolic::codegen::export::Language;
@@ -91,6 +91,7 @@ pub fn equations(
     eomgen_symbolic::mechanics::limit_derivation(&mut model);
     let eom = match derivation {
         Derivation::Lagrange => Lagrange.derive(&mut model),
+        Derivation::Momentum if Kane::applies_to(&model) => Kane.derive(&mut model),
         Derivation::Momentum => {
             if !MomentumBalance::applies_to(&model) {
                 return Err(ListingError::NoMomentumForm {

@@ -8,7 +8,7 @@ use crate::common::accelerations;
 
 use eomgen_symbolic::expr::eval::Evaluator;
 use eomgen_symbolic::expr::{ExprId, SymbolKind};
-use eomgen_symbolic::mechanics::{Formulation, Lagrange, MomentumBalance, SymbolicModel};
+use eomgen_symbolic::mechanics::{Formulation, Kane, Lagrange, SymbolicModel};
 use rand::rngs::Xoshiro256PlusPlus;
 use rand::{RngExt, SeedableRng};
 
@@ -61,7 +61,7 @@ fn relative(a: &[f64], b: &[f64]) -> f64 {
 #[test]
 fn a_free_body_in_body_rates_has_eulers_equations() {
     let mut model = lowered(FREE_BODY);
-    let kane = MomentumBalance.derive(&mut model);
+    let kane = Kane.derive(&mut model);
     let lagrange = Lagrange.derive(&mut model);
     let zero = model.arena.int(0);
     let diagonal = ["I1", "I2", "I3"].map(|name| {
@@ -102,7 +102,7 @@ fn a_free_body_in_body_rates_has_eulers_equations() {
 #[test]
 fn the_heavy_top_in_body_rates_has_eulers_equations_with_gravity() {
     let mut model = lowered(TOP);
-    let kane = MomentumBalance.derive(&mut model);
+    let kane = Kane.derive(&mut model);
     let lagrange = Lagrange.derive(&mut model);
     let (m, g, l, i1, i3) = (1.0, 9.81, 0.1, 0.02, 0.01);
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(7);
@@ -197,7 +197,7 @@ fn a_chain_in_relative_rates_moves_as_in_absolute_ones() {
     );
     assert!(with.contains("u2: theta2_dot - theta1_dot"));
     let mut speeds_model = lowered(&with);
-    let kane = MomentumBalance.derive(&mut speeds_model);
+    let kane = Kane.derive(&mut speeds_model);
     let carried = Lagrange.derive(&mut speeds_model);
     let mut rates_model = lowered(&base);
     let reference = Lagrange.derive(&mut rates_model);

@@ -11,7 +11,7 @@ use super::BalanceInfo;
 use super::lower::StateBox;
 pub use super::numeric::solve;
 use super::{
-    EnergyRate, EquationsOfMotion, Formulation, HandEquations, Lagrange, MomentumBalance,
+    EnergyRate, EquationsOfMotion, Formulation, HandEquations, Kane, Lagrange, MomentumBalance,
     PowerRoute, SymbolicModel, UserBalances, energy_routes_skipped,
 };
 use crate::expr::eval::Evaluator;

@@ -43,7 +43,12 @@ impl Formulation for Lagrange {
         // In generalized speeds: the equations derived in the rates before the switch,
         // carried into the speeds (`super::speeds`).
         if let Some(speeds) = &model.speeds {
-            return speeds.lagrange.clone();
+            let (mass_matrix, forcing) = speeds.lagrange.clone();
+            return EquationsOfMotion {
+                num_dofs: forcing.len(),
+                mass_matrix,
+                forcing,
+            };
         }
         let n = model.num_dofs();
         let (mass_matrix, inertial, applied) = parts(model);

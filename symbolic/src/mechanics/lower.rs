@@ -120,6 +120,26 @@ pub enum BalanceInfo {
     },
 }
 
+/// What a model with generalized speeds keeps of them ([`SymbolicModel::speeds`]; built and
+/// used by `super::speeds`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Speeds {
+    /// The speeds' names, in file order (one per coordinate).
+    pub names: Vec<String>,
+    /// The kinematic equations: `q̇ⱼ` as an expression of `q`, `u` and `t`, per coordinate.
+    pub kinematic_equations: Vec<ExprId>,
+    /// `W = Y⁻¹`, `n × n` row-major: `q̇ = W (u − Z)`.
+    pub inverse: Vec<ExprId>,
+    /// `Z(q, t)`, per speed: its value with every rate 0.
+    pub offsets: Vec<ExprId>,
+    /// Lagrange's equations carried into the speeds: `M` (`n × n`, row-major) and `F`.
+    pub lagrange: (Vec<ExprId>, Vec<ExprId>),
+    /// `det(Y)`, multiplied out.
+    pub(crate) determinant: ExprId,
+    /// `adj(Y)`, `n × n` row-major, each entry multiplied out.
+    pub(crate) adjugate: Vec<ExprId>,
+}
+
 /// A model file turned into expressions: everything a [`super::Formulation`] needs.
 #[derive(Debug, Clone)]
 pub struct SymbolicModel {
@@ -204,7 +224,7 @@ pub struct SymbolicModel {
     /// With `speeds:`, the generalized speeds: the state is `(q, u)`, the coordinates'
     /// triples hold `(q, u, u̇)`, and every expression above is in them
     /// ([`super::speeds`]); `None`: the state is `(q, q̇)`.
-    pub speeds: Option<super::speeds::Speeds>,
+    pub speeds: Option<Speeds>,
     /// The file's `checks:` reference results, as the model's description keeps them.
     pub checks: eomgen_description::checks::Checks,
     /// The file's `floquet:` references, as the model's description keeps them.
@@ -350,16 +370,22 @@ impl SymbolicModel {
             .collect();
         StateBox { axes }
     }
-
-    /// Lowers a checked model file.
-    ///
-    /// # Errors
-    /// A diagnostic for anything the checks should have rejected (unknown name, wrong
-    /// dimension); with a model that passed [`crate::model::load`] this does not happen.
-    pub fn from_file(file: &ModelFile) -> Result<Self, Vec<Diagnostic>> {
-        Lowering::new(file).run()
-    }
 }
+
+/// A checked model file lowered as it is written, in the coordinates' rates
+/// ([`SymbolicModel::from_file`] then switches a file with `speeds:` to them), with the
+/// speeds' definitions (in the rates, file order) and their `initial:` values if the file
+/// gives any.
+///
+/// # Errors
+/// A diagnostic for anything the checks should have rejected (unknown name, wrong
+/// dimension); with a model that passed [`crate::model::load`] this does not happen.
+pub(super) fn lower_file(file: &ModelFile) -> Result<Lowered, Vec<Diagnostic>> {
+    Lowering::new(file).run()
+}
+
+/// What [`lower_file`] gives: the model, the speeds' definitions and their initial values.
+pub(super) type Lowered = (SymbolicModel, Vec<ExprId>, Option<Vec<ExprId>>);
 
 struct Lowering<'f> {
     file: &'f ModelFile,
@@ -407,7 +433,7 @@ impl<'f> Lowering<'f> {
     /// hence the canonical order of sums and products and the generated code.
     // Long: it calls each section's lowering in the order they depend on each other, then
     // gathers the forty fields of the lowered model; the work of each is in its own method.
-    fn run(mut self) -> Result<SymbolicModel, Vec<Diagnostic>> {
+    fn run(mut self) -> Result<Lowered, Vec<Diagnostic>> {
         let file = self.file;
         let time_id = self.arena.time_id();
         let time = self.arena.symbol_expr(time_id);
@@ -571,10 +597,7 @@ impl<'f> Lowering<'f> {
                 .collect(),
             speeds: None,
         };
-        if file.speeds.is_empty() {
-            return Ok(model);
-        }
-        super::speeds::switch(model, &speed_definitions, initial_speeds, file)
+        Ok((model, speed_definitions, initial_speeds))
     }
 
     /// The initial speeds `initial:` gives (0 for one it does not give), or `None` if it

@@ -26,6 +26,7 @@ pub use energy::{EnergyRate, PowerRoute, energy_routes_skipped};
 pub use kinematics::{FrameKinematics, PointKinematics, Reaction, ReactionError};
 pub use lagrange::Lagrange;
 pub use limit::{DERIVATION_OPERAND_LIMIT, finish_derivation, limit_derivation};
+pub use lower::Speeds;
 pub use lower::{
     BalanceInfo, BalanceSet, BodyInfo, Equilibrium, EventInfo, LoadInfo, ParameterInfo,
     SpatialBody, SymbolicModel,
@@ -33,7 +34,7 @@ pub use lower::{
 pub use mass::mass_matrix_diagnostics;
 pub use momentum::MomentumBalance;
 pub use preferred::{preferred_equations, preferred_formulation};
-pub use speeds::Speeds;
+pub use speeds::Kane;
 
 use crate::expr::ExprId;
 

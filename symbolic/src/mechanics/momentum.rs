@@ -57,11 +57,11 @@ use crate::model::elements::{damper, spring};
 pub struct MomentumBalance;
 
 impl MomentumBalance {
-    /// Whether the model can be derived by momentum balance: it has bodies and no written
-    /// `kinetic:` (a written `potential:` enters as the generalized forces `−∂V/∂qᵢ`, written
+    /// Whether the model can be derived by momentum balance: it has bodies, no written
+    /// `kinetic:` and no generalized speeds (whose equations are [`super::Kane`]'s) (a written `potential:` enters as the generalized forces `−∂V/∂qᵢ`, written
     /// `generalized_forces:` as themselves).
     pub fn applies_to(model: &SymbolicModel) -> bool {
-        !model.kinetic_written && !model.bodies.is_empty()
+        !model.kinetic_written && !model.bodies.is_empty() && model.speeds.is_none()
     }
 }
 
@@ -297,10 +297,6 @@ impl Formulation for MomentumBalance {
     /// Never; for a model where [`MomentumBalance::applies_to`] is false a written `kinetic:`
     /// is ignored, so callers check it first.
     fn derive(&self, model: &mut SymbolicModel) -> EquationsOfMotion {
-        // In generalized speeds: Kane's equations, on the partial velocities in the speeds.
-        if model.speeds.is_some() {
-            return super::speeds::kane(model);
-        }
         let n = model.num_dofs();
         let symbols: Vec<_> = (0..n).map(|i| model.coordinate_symbols(i)).collect();
         let time = model.time_symbol();

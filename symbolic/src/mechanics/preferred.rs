@@ -3,9 +3,11 @@
 use super::lagrange::Lagrange;
 use super::lower::SymbolicModel;
 use super::momentum::MomentumBalance;
+use super::speeds::Kane;
 use super::{EquationsOfMotion, Formulation};
 
-/// The formulation whose equations generated code uses: momentum balance for a model in the
+/// The formulation whose equations generated code uses: Kane's for a model in generalized
+/// speeds ([`Kane::applies_to`]), momentum balance for a model in the
 /// kinematic form with no written energy or generalized forces
 /// ([`MomentumBalance::applies_to`] and not [`SymbolicModel::uses_energy_form`]), Lagrange
 /// otherwise. (A kinematic file with a written `potential:` or `generalized_forces:` is
@@ -22,7 +24,9 @@ use super::{EquationsOfMotion, Formulation};
 /// (the rule before issue 18), no bundled model gets more than one more operation, and the
 /// 3-spring line loses 26 in its Jacobians for its one operation in `F`.
 pub fn preferred_formulation(model: &SymbolicModel) -> &'static dyn Formulation {
-    if MomentumBalance::applies_to(model) && !model.uses_energy_form {
+    if Kane::applies_to(model) && !model.uses_energy_form {
+        &Kane
+    } else if MomentumBalance::applies_to(model) && !model.uses_energy_form {
         &MomentumBalance
     } else {
         &Lagrange

@@ -32,30 +32,53 @@
 use rustc_hash::FxHashMap;
 
 use super::frames::{Vector3, cross, tensor_times};
-use super::lower::LoadInfo;
+use super::lower::{LoadInfo, Speeds};
 use super::momentum::{LoadForces, dot, linear_in_accelerations, load_forces};
 use super::{EquationsOfMotion, Formulation, Lagrange, SymbolicModel};
 use crate::expr::{ExprArena, ExprId, Node, SymbolId};
 use crate::model::diagnostic::Diagnostic;
 use crate::model::file::ModelFile;
 
-/// What a model with generalized speeds keeps of them ([`SymbolicModel::speeds`]).
-#[derive(Debug, Clone, PartialEq)]
-pub struct Speeds {
-    /// The speeds' names, in file order (one per coordinate).
-    pub names: Vec<String>,
-    /// The kinematic equations: `q̇ⱼ` as an expression of `q`, `u` and `t`, per coordinate.
-    pub kinematic_equations: Vec<ExprId>,
-    /// `W = Y⁻¹`, `n × n` row-major: `q̇ = W (u − Z)`.
-    pub inverse: Vec<ExprId>,
-    /// `Z(q, t)`, per speed: its value with every rate 0.
-    pub offsets: Vec<ExprId>,
-    /// Lagrange's equations carried into the speeds.
-    pub lagrange: EquationsOfMotion,
-    /// `det(Y)`, multiplied out.
-    determinant: ExprId,
-    /// `adj(Y)`, `n × n` row-major, each entry multiplied out.
-    adjugate: Vec<ExprId>,
+impl SymbolicModel {
+    /// Lowers a checked model file ([`super::lower`]); with `speeds:`, then switches its state
+    /// to the speeds ([`switch`]).
+    ///
+    /// # Errors
+    /// A diagnostic for anything the checks should have rejected (unknown name, wrong
+    /// dimension; with a model that passed [`crate::model::load`] this does not happen), and
+    /// the speeds' mistakes that only the lowered expressions show (see [`switch`]).
+    pub fn from_file(file: &ModelFile) -> Result<Self, Vec<Diagnostic>> {
+        let (model, definitions, initial) = super::lower::lower_file(file)?;
+        if file.speeds.is_empty() {
+            return Ok(model);
+        }
+        switch(model, &definitions, initial, file)
+    }
+}
+
+/// Kane's equations in generalized speeds: each body's momentum balance projected on the
+/// partial velocities and partial angular velocities in the speeds (see the module docs).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Kane;
+
+impl Kane {
+    /// Whether the model is in generalized speeds, with bodies and no written `kinetic:`
+    /// (as for [`super::MomentumBalance::applies_to`], which such a model does not take).
+    pub fn applies_to(model: &SymbolicModel) -> bool {
+        model.speeds.is_some() && !model.kinetic_written && !model.bodies.is_empty()
+    }
+}
+
+impl Formulation for Kane {
+    fn name(&self) -> &'static str {
+        "kane"
+    }
+
+    /// # Panics
+    /// For a model without speeds ([`Kane::applies_to`]).
+    fn derive(&self, model: &mut SymbolicModel) -> EquationsOfMotion {
+        kane(model)
+    }
 }
 
 /// Switches `model`'s state to the speeds of `file`, whose definitions (in `q`, `q̇`, `t`, as
@@ -146,7 +169,7 @@ pub(crate) fn switch(
         kinematic_equations: rates,
         inverse,
         offsets,
-        lagrange: lagrange_q.clone(),
+        lagrange: (Vec::new(), Vec::new()),
         determinant,
         adjugate,
     };
@@ -226,7 +249,10 @@ pub(crate) fn switch(
         &lagrange_forcing,
         &accelerations,
     );
-    model.speeds = Some(Speeds { lagrange, ..speeds });
+    model.speeds = Some(Speeds {
+        lagrange: (lagrange.mass_matrix, lagrange.forcing),
+        ..speeds
+    });
     Ok(model)
 }
 
@@ -397,9 +423,8 @@ fn minor(
 /// Kane's equations in the speeds of `model` (see the module docs), `M u̇ = F`.
 ///
 /// # Panics
-/// If `model` has no speeds (a programmer error: [`super::MomentumBalance`] calls it only for
-/// such a model).
-pub(crate) fn kane(model: &mut SymbolicModel) -> EquationsOfMotion {
+/// If `model` has no speeds (a programmer error: [`Kane::applies_to`] is checked first).
+fn kane(model: &mut SymbolicModel) -> EquationsOfMotion {
     let speeds = model.speeds.clone().expect("a model with speeds");
     let n = model.num_dofs();
     let symbols: Vec<[SymbolId; 3]> = (0..n).map(|i| model.coordinate_symbols(i)).collect();

@@ -33,7 +33,7 @@ pub fn check_model(
     let symbolic_equal: Vec<Option<bool>> = others
         .iter()
         .map(|(name, b)| {
-            (name == MomentumBalance.name()).then(|| {
+            (name == MomentumBalance.name() || name == Kane.name()).then(|| {
                 let arena = &mut model.arena;
                 lagrange
                     .mass_matrix
@@ -141,10 +141,17 @@ fn derive_others(
     let mut others: Vec<(String, EquationsOfMotion)> = Vec::new();
     // The index in `model.balance_sets` of each of `others` that is a set of balances.
     let mut balance_set_of: Vec<Option<usize>> = Vec::new();
-    if MomentumBalance::applies_to(model) {
-        let (eom, stats) = timed(model, &MomentumBalance, MomentumBalance.name(), file)?;
+    let momentum: Option<&dyn Formulation> = if Kane::applies_to(model) {
+        Some(&Kane)
+    } else if MomentumBalance::applies_to(model) {
+        Some(&MomentumBalance)
+    } else {
+        None
+    };
+    if let Some(momentum) = momentum {
+        let (eom, stats) = timed(model, momentum, momentum.name(), file)?;
         derivations.push(stats);
-        others.push((MomentumBalance.name().to_string(), eom));
+        others.push((momentum.name().to_string(), eom));
         balance_set_of.push(None);
     } else {
         notes.push(NO_MOMENTUM_BALANCE.to_string());
