@@ -37,6 +37,7 @@ mod response;
 mod rolling_contact;
 mod runtime_models;
 mod simulation;
+mod speeds;
 mod stability;
 mod steady_motions;
 mod steady_turns;

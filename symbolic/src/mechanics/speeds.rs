@@ -95,6 +95,9 @@ pub(crate) fn switch(
     file: &ModelFile,
 ) -> Result<SymbolicModel, Vec<Diagnostic>> {
     let n = model.num_dofs();
+    // Bounded as every derivation is (a file of deeply nested rotations); the switch below
+    // multiplies out no more than the partial velocities.
+    super::limit_derivation(&mut model);
     let lagrange_q = Lagrange.derive(&mut model);
     let old: Vec<[SymbolId; 3]> = (0..n).map(|i| model.coordinate_symbols(i)).collect();
     let arena = &mut model.arena;
@@ -253,6 +256,7 @@ pub(crate) fn switch(
         lagrange: (lagrange.mass_matrix, lagrange.forcing),
         ..speeds
     });
+    super::finish_derivation(&mut model, file)?;
     Ok(model)
 }
 

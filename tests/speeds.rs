@@ -1,0 +1,69 @@
+//! Generalized speeds from the command line: `equations` lists Kane's equations in the speeds
+//! with the kinematic equations, `check` compares them with Lagrange's carried into the speeds,
+//! and the commands that would run the model in the state `(q, q̇)` refuse it with a located
+//! message (exit 2) instead of a wrong result.
+
+use crate::common::{eomgen, eomgen_ok};
+
+fn fixture(name: &str) -> String {
+    format!("{}/tests/fixtures/{name}", env!("CARGO_MANIFEST_DIR"))
+}
+
+/// The heavy top in body rates lists Euler's equations about its pivot (the closed form is
+/// checked at random states in `symbolic/tests/speeds.rs`; here, what is printed) and the
+/// kinematic equations of z-x-z angles; both derivations agree in `check`.
+#[test]
+fn a_top_in_body_rates_lists_and_checks_kanes_equations() {
+    let top = fixture("heavy_top_speeds.yaml");
+    let out = eomgen_ok(&["equations", &top]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    for line in [
+        "u = [w1, w2, w3]",
+        "  theta' = cos(psi)*w1 - sin(psi)*w2",
+        "M u' = F with",
+        "  M[0,0] = I1",
+        "  M[0,1] = 0",
+        "  M[2,2] = I3",
+        "  F[2] = 0",
+    ] {
+        assert!(
+            text.lines().any(|l| l == line),
+            "no line `{line}` in:\n{text}"
+        );
+    }
+    let out = eomgen_ok(&["equations", &top, "--json"]);
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
+    assert_eq!(
+        json["equations"]["speeds"],
+        serde_json::json!(["w1", "w2", "w3"])
+    );
+    assert_eq!(
+        json["equations"]["kinematic_equations"]
+            .as_array()
+            .map(Vec::len),
+        Some(3)
+    );
+    let out = eomgen_ok(&["check", &top]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("ok   lagrange vs kane"), "{text}");
+}
+
+/// `simulate`, `modes` and the exported code refuse a model in speeds, naming the line of
+/// its first speed, with exit 2.
+#[test]
+fn a_model_in_speeds_is_not_run_in_the_wrong_state() {
+    let body = fixture("free_rigid_body_speeds.yaml");
+    for args in [
+        vec!["simulate", body.as_str()],
+        vec!["modes", body.as_str()],
+        vec!["equations", body.as_str(), "--c"],
+    ] {
+        let out = eomgen(&args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(
+            err.contains("free_rigid_body_speeds.yaml:20:3: a model with generalized speeds is derived and printed"),
+            "{args:?}: {err}"
+        );
+    }
+}
