@@ -223,7 +223,7 @@ pub struct SymbolicModel {
     pub equilibria: Vec<Equilibrium>,
     /// With `speeds:`, the generalized speeds: the state is `(q, u)`, the coordinates'
     /// triples hold `(q, u, u̇)`, and every expression above is in them
-    /// ([`super::speeds`]); `None`: the state is `(q, q̇)`.
+    /// (`mechanics/speeds.rs`); `None`: the state is `(q, q̇)`.
     pub speeds: Option<Speeds>,
     /// The file's `checks:` reference results, as the model's description keeps them.
     pub checks: eomgen_description::checks::Checks,

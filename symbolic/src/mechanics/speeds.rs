@@ -40,13 +40,14 @@ use crate::model::diagnostic::Diagnostic;
 use crate::model::file::ModelFile;
 
 impl SymbolicModel {
-    /// Lowers a checked model file ([`super::lower`]); with `speeds:`, then switches its state
-    /// to the speeds ([`switch`]).
+    /// Lowers a checked model file (`mechanics/lower.rs`); with `speeds:`, then switches its
+    /// state to the speeds (`mechanics/speeds.rs`).
     ///
     /// # Errors
     /// A diagnostic for anything the checks should have rejected (unknown name, wrong
     /// dimension; with a model that passed [`crate::model::load`] this does not happen), and
-    /// the speeds' mistakes that only the lowered expressions show (see [`switch`]).
+    /// the speeds' mistakes that only the lowered expressions show (a speed not linear in the
+    /// rates, speeds that do not determine them).
     pub fn from_file(file: &ModelFile) -> Result<Self, Vec<Diagnostic>> {
         let (model, definitions, initial) = super::lower::lower_file(file)?;
         if file.speeds.is_empty() {
