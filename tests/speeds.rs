@@ -67,3 +67,42 @@ fn a_model_in_speeds_is_not_run_in_the_wrong_state() {
         );
     }
 }
+
+/// The partial angular velocities `kinematics --partial` lists for a model in speeds are
+/// with respect to the speeds, and say so: the body's own rates give the unit vectors.
+#[test]
+fn partial_velocities_are_with_respect_to_the_speeds() {
+    let top = fixture("heavy_top_speeds.yaml");
+    let out = eomgen_ok(&["kinematics", &top, "--frame", "B", "--partial"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    for line in [
+        "  d omega/d w1 = [1, 0, 0]",
+        "  d omega/d w2 = [0, 1, 0]",
+        "  d omega/d w3 = [0, 0, 1]",
+    ] {
+        assert!(
+            text.lines().any(|l| l == line),
+            "no line `{line}` in:\n{text}"
+        );
+    }
+}
+
+/// Under `units: SI` a speed has its definition's unit: a force written as a speed in m/s is
+/// refused at its place.
+#[test]
+fn a_speed_has_the_unit_of_its_definition() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let path = dir.path().join("units.yaml");
+    std::fs::write(
+        &path,
+        "name: p\nunits: SI\nparameters: { m: 1.0 }  # kg\ncoordinates: [x]  # m\nspeeds: { v: x_dot }\npoints: { P: [x, 0] }\nbodies: { ball: { mass: m, at: P } }\nforces: { push: { at: P, vector: [v, 0] } }\n",
+    )
+    .expect("written");
+    let out = eomgen(&["check", path.to_str().expect("a path")]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("units.yaml:8:35: the x component of force `push` is m/s, but a force is N"),
+        "{err}"
+    );
+}

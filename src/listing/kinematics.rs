@@ -106,6 +106,10 @@ pub struct Kinematics {
     pub model: String,
     /// The coordinates `qᵢ`, the order of the partial velocities.
     pub coordinates: Vec<String>,
+    /// With generalized speeds (`speeds:`), the speeds `uᵢ` the partial velocities are taken
+    /// with respect to (in place of the rates); left out of the JSON otherwise.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub speeds: Vec<String>,
     /// The frames and points in the model file's syntax.
     #[serde(flatten)]
     pub listing: KinematicsListing,
@@ -123,7 +127,7 @@ pub struct Kinematics {
 /// `options` asks for: each frame's `^N ω^F` (in its own and in `N`'s components) and
 /// `^N α^F`, each point's position, velocity and acceleration in `N`, and with
 /// `options.partial` the partial velocities with the coordinate rates as generalized
-/// speeds.
+/// speeds (with `speeds:`, with respect to the file's speeds).
 ///
 /// # Errors
 /// [`ListingError::Diagnostics`] for a file with mistakes; [`ListingError::UnknownName`] for
@@ -245,11 +249,15 @@ pub fn kinematics(
     let listing = list(Syntax::Text);
     let latex = list(Syntax::Latex);
     let coordinates = model.coordinate_names.clone();
+    // What the partial velocities are taken with respect to: the rates `q_dot`, or with
+    // generalized speeds (`speeds:`) the speeds.
+    let speeds: Option<Vec<String>> = model.speeds.as_ref().map(|s| s.names.clone());
     Ok(Kinematics {
-        text: render_text(&model.name, &coordinates, &listing),
-        latex_document: render_latex(&coordinates, &latex),
+        text: render_text(&model.name, &coordinates, speeds.as_deref(), &listing),
+        latex_document: render_latex(&coordinates, speeds.as_deref(), &latex),
         model: model.name.clone(),
         coordinates,
+        speeds: speeds.unwrap_or_default(),
         listing,
         latex,
     })
@@ -287,7 +295,16 @@ fn vector(v: &[String]) -> String {
 }
 
 /// The listing as `eomgen kinematics` prints it.
-fn render_text(model: &str, coordinates: &[String], k: &KinematicsListing) -> String {
+fn render_text(
+    model: &str,
+    coordinates: &[String],
+    speeds: Option<&[String]>,
+    k: &KinematicsListing,
+) -> String {
+    let rates: Vec<String> = match speeds {
+        Some(speeds) => speeds.to_vec(),
+        None => coordinates.iter().map(|q| format!("{q}_dot")).collect(),
+    };
     let mut out = String::new();
     let _ = writeln!(out, "kinematics of `{model}` in the ground frame N");
     for f in &k.frames {
@@ -313,8 +330,8 @@ fn render_text(model: &str, coordinates: &[String], k: &KinematicsListing) -> St
             f.name,
             vector(&f.angular_acceleration)
         );
-        for (q, w) in coordinates.iter().zip(&f.partial_angular_velocities) {
-            let _ = writeln!(out, "  d omega/d {q}_dot = {}", vector(w));
+        for (u, w) in rates.iter().zip(&f.partial_angular_velocities) {
+            let _ = writeln!(out, "  d omega/d {u} = {}", vector(w));
         }
     }
     for r in &k.reactions {
@@ -332,8 +349,8 @@ fn render_text(model: &str, coordinates: &[String], k: &KinematicsListing) -> St
         let _ = writeln!(out, "  r = {}", vector(&p.position));
         let _ = writeln!(out, "  v = {}", vector(&p.velocity));
         let _ = writeln!(out, "  a = {}", vector(&p.acceleration));
-        for (q, v) in coordinates.iter().zip(&p.partial_velocities) {
-            let _ = writeln!(out, "  d v/d {q}_dot = {}", vector(v));
+        for (u, v) in rates.iter().zip(&p.partial_velocities) {
+            let _ = writeln!(out, "  d v/d {u} = {}", vector(v));
         }
     }
     out
@@ -346,15 +363,21 @@ fn latex_vector(v: &[String]) -> String {
 
 /// The listing as `eomgen kinematics --latex` prints it: an amsmath document body, one
 /// `lhs &= [v] \\` row per vector.
-fn render_latex(coordinates: &[String], k: &KinematicsListing) -> String {
+fn render_latex(
+    coordinates: &[String],
+    speeds: Option<&[String]>,
+    k: &KinematicsListing,
+) -> String {
     let symbol = eomgen_symbolic::expr::print::latex_symbol;
     let mut rows: Vec<(String, &[String])> = Vec::new();
-    let partial = |of: &str, q: &str| {
-        format!(
-            "\\frac{{\\partial\\, {of}}}{{\\partial \\dot{{{}}}}}",
-            symbol(q)
-        )
+    // With respect to `q̇ᵢ`, or with generalized speeds to `uᵢ`.
+    let rates: Vec<String> = match speeds {
+        Some(speeds) => speeds.iter().map(|u| symbol(u)).collect(),
+        None => (coordinates.iter())
+            .map(|q| format!("\\dot{{{}}}", symbol(q)))
+            .collect(),
     };
+    let partial = |of: &str, u: &str| format!("\\frac{{\\partial\\, {of}}}{{\\partial {u}}}");
     for f in &k.frames {
         let frame = symbol(&f.name);
         let omega = format!("{{}}^{{N}}\\boldsymbol{{\\omega}}^{{{frame}}}");
@@ -369,8 +392,8 @@ fn render_latex(coordinates: &[String], k: &KinematicsListing) -> String {
         let alpha =
             format!("{{}}^{{N}}\\boldsymbol{{\\alpha}}^{{{frame}}} \\quad (\\text{{in }} {frame})");
         rows.push((alpha, &f.angular_acceleration));
-        for (q, w) in coordinates.iter().zip(&f.partial_angular_velocities) {
-            rows.push((partial(&omega, q), w));
+        for (u, w) in rates.iter().zip(&f.partial_angular_velocities) {
+            rows.push((partial(&omega, u), w));
         }
     }
     for p in &k.points {
@@ -382,8 +405,8 @@ fn render_latex(coordinates: &[String], k: &KinematicsListing) -> String {
             format!("{{}}^{{N}}\\mathbf{{a}}_{{{point}}}"),
             &p.acceleration,
         ));
-        for (q, v) in coordinates.iter().zip(&p.partial_velocities) {
-            rows.push((partial(&velocity, q), v));
+        for (u, v) in rates.iter().zip(&p.partial_velocities) {
+            rows.push((partial(&velocity, u), v));
         }
     }
     for r in &k.reactions {

@@ -231,7 +231,12 @@ pub fn equations_text(model: &SymbolicModel, eom: &EquationsOfMotion) -> String 
         "q''"
     } else {
         let _ = writeln!(s, "u = [{}]", e.speeds.join(", "));
-        let _ = writeln!(s, "q' = W(q, t) u (the kinematic equations) with");
+        let form = if model.speeds_have_offsets() {
+            "q' = W(q, t) (u - Z(q, t))"
+        } else {
+            "q' = W(q, t) u"
+        };
+        let _ = writeln!(s, "{form} (the kinematic equations) with");
         for (q, k) in e.coordinates.iter().zip(&e.kinematic_equations) {
             let _ = writeln!(s, "  {q}' = {k}");
         }
@@ -326,6 +331,11 @@ pub fn equations_latex(model: &SymbolicModel, eom: &EquationsOfMotion) -> String
         )
     };
     let mut s = String::new();
+    // With generalized speeds, the kinematic equations first.
+    for (q, k) in e.coordinates.iter().zip(&e.kinematic_equations) {
+        let rate = crate::expr::print::latex_symbol(&format!("{q}_dot"));
+        let _ = writeln!(s, "{rate} = {k}\\\\");
+    }
     let _ = writeln!(s, "T = {}", e.kinetic_energy);
     let _ = writeln!(s, "\\\\\nV = {}", e.potential_energy);
     let rows: Vec<String> = e.mass_matrix.iter().map(|row| row.join(" & ")).collect();

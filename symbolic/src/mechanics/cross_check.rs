@@ -590,7 +590,9 @@ fn sample_states(
     let mut max_rel: Vec<f64> = vec![0.0; others.len()];
     let mut row_rel: Vec<Vec<f64>> = vec![vec![0.0; n]; others.len()];
     let mut power_rel: f64 = 0.0;
-    let mut quadratic = true;
+    // In speeds with an offset, `T(q, u)` says nothing of `T`'s degree in `q̇`: not tested,
+    // the power balance skipped.
+    let mut quadratic = !model.speeds_have_offsets();
     let symbols = model.arena.symbols().to_vec();
     let defaults = defaults_by_symbol(model);
     let state_box = model.state_box();

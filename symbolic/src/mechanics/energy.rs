@@ -65,6 +65,10 @@ pub fn energy_routes_skipped(model: &SymbolicModel) -> Option<&'static str> {
         Some(
             "energy and power routes skipped: T or V depends explicitly on t (a driven support works through its reaction force)",
         )
+    } else if model.speeds_have_offsets() {
+        Some(
+            "energy and power routes skipped: a generalized speed has an offset Z(q, t) (u = Y q̇ + Z), so T in the speeds does not show whether it is a quadratic form in q̇",
+        )
     } else if !kinetic_is_quadratic_in_rate(model) {
         Some(
             "energy and power routes skipped: T is not a quadratic form in q̇ (a driven motion, such as a rod spun at a constant rate, gives T terms of degree 0 or 1 in q̇): then Ė is not q̇ times the equation of motion",

@@ -332,6 +332,15 @@ impl SymbolicModel {
         self.arena.coordinates()[i]
     }
 
+    /// Whether the model is in generalized speeds with an offset `Z(q, t) ≠ 0` in one of them
+    /// (`u = Y q̇ + Z`): its `T`, a quadratic form in `q̇` or not, is then not homogeneous in
+    /// the speeds, and tests of that in the speeds do not apply.
+    pub fn speeds_have_offsets(&self) -> bool {
+        (self.speeds.iter())
+            .flat_map(|s| &s.offsets)
+            .any(|z| !self.arena.is_zero(*z))
+    }
+
     /// The time symbol id.
     pub fn time_symbol(&self) -> SymbolId {
         self.time_id

@@ -108,22 +108,28 @@ pub(crate) fn switch(
     let mut offsets = Vec::with_capacity(n);
     let mut errors = Vec::new();
     for (r, &d) in definitions.iter().enumerate() {
-        for s in &old {
-            let c = arena.diff(d, s[1]);
-            let nonlinear = old.iter().any(|t| {
-                let cc = arena.diff(c, t[1]);
-                !arena.is_zero(cc)
-            });
-            if nonlinear {
-                let speed = &file.speeds[r];
-                errors.push(
-                    Diagnostic::new(speed.value.location, format!("speed `{}` is not linear in the rates", speed.name.value))
-                        .with_help("a generalized speed is a combination of the rates with coefficients in the coordinates and `t`, such as `omega_B_x` or `theta1_dot + theta2_dot`"),
-                );
-            }
-            y.push(c);
+        // Linear in the rates: coefficients free of them, and `d − Y q̇ − Z` multiplied out
+        // free of them too (`abs` and `sign` have derivatives free of their argument).
+        let row: Vec<ExprId> = old.iter().map(|s| arena.diff(d, s[1])).collect();
+        let z = arena.substitute(d, &at_rest);
+        let mut rest = vec![d, arena.neg(z)];
+        for (c, s) in row.iter().zip(&old) {
+            let rate = arena.symbol_expr(s[1]);
+            let term = arena.times(*c, rate);
+            rest.push(arena.neg(term));
         }
-        offsets.push(arena.substitute(d, &at_rest));
+        let rest = arena.sum(&rest);
+        let rest = arena.expand(rest);
+        let rates_in = |arena: &ExprArena, e: ExprId| old.iter().any(|t| arena.depends_on(e, t[1]));
+        if row.iter().any(|&c| rates_in(arena, c)) || rates_in(arena, rest) {
+            let speed = &file.speeds[r];
+            errors.push(
+                Diagnostic::new(speed.value.location, format!("speed `{}` is not linear in the rates", speed.name.value))
+                    .with_help("a generalized speed is a combination of the rates with coefficients in the coordinates and `t`, such as `omega_B_x` or `theta1_dot + theta2_dot`"),
+            );
+        }
+        y.extend(row);
+        offsets.push(z);
     }
     if !errors.is_empty() {
         return Err(errors);
@@ -232,7 +238,14 @@ pub(crate) fn switch(
     for event in &mut model.events {
         event.function = sub(arena, event.function);
     }
-    let lagrange_forcing: Vec<ExprId> = lagrange_q.forcing.iter().map(|&f| sub(arena, f)).collect();
+    // `M` too: Lagrange's `M` holds the rates where `T` is not quadratic in them.
+    let lagrange_mass: Vec<ExprId> = (lagrange_q.mass_matrix.iter())
+        .map(|&m| sub(arena, m))
+        .collect();
+    let lagrange_forcing: Vec<ExprId> = (lagrange_q.forcing.iter())
+        .map(|&f| sub(arena, f))
+        .collect();
+
     model.initial_qdot = match initial {
         Some(u0) => u0,
         None => {
@@ -247,12 +260,7 @@ pub(crate) fn switch(
                 .collect()
         }
     };
-    let lagrange = speeds.carried(
-        arena,
-        &lagrange_q.mass_matrix,
-        &lagrange_forcing,
-        &accelerations,
-    );
+    let lagrange = speeds.carried(arena, &lagrange_mass, &lagrange_forcing, &accelerations);
     model.speeds = Some(Speeds {
         lagrange: (lagrange.mass_matrix, lagrange.forcing),
         ..speeds

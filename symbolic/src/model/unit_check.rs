@@ -332,6 +332,9 @@ struct Checker<'f> {
     /// The units of the constraints visited so far in this pass, for their multipliers
     /// (`lambda_<name>`): `(name, unit, holonomic)`.
     constraints: Vec<(String, Option<Dim>, bool)>,
+    /// The units of the generalized speeds (`speeds:`), their definitions', once visited in
+    /// this pass (first of all).
+    speeds: Vec<(String, Option<Dim>)>,
     /// How the key being checked spells its unit, while its value is a lone name.
     spelling: Option<String>,
     solution: Vec<Option<Solved>>,
@@ -579,6 +582,7 @@ impl<'f> Checker<'f> {
             unknowns,
             equations: Vec::new(),
             constraints: Vec::new(),
+            speeds: Vec::new(),
             spelling: None,
             names: Vec::new(),
             failing_names: Vec::new(),
@@ -653,6 +657,9 @@ impl<'f> Checker<'f> {
         }
         if self.file.angular_velocity_name(n).is_some() {
             return Some(Dim::of(Dimension::FREQUENCY));
+        }
+        if let Some((_, unit)) = self.speeds.iter().find(|(k, _)| k == n) {
+            return unit.clone();
         }
         // Names already reported take any unit.
         self.motion(n).flatten()

@@ -88,6 +88,9 @@ pub fn check_model(
     let power_balance = if explicit_time {
         notes.push("power balance skipped: T or V depends explicitly on t".to_string());
         None
+    } else if model.speeds_have_offsets() {
+        notes.push("power balance skipped: a generalized speed has an offset Z(q, t) (u = Y q̇ + Z), so T in the speeds does not show whether it is a quadratic form in q̇".to_string());
+        None
     } else if !quadratic {
         notes.push("power balance skipped: T is not a quadratic form in the rates".to_string());
         None

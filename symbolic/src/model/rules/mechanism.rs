@@ -77,6 +77,24 @@ impl Checker<'_> {
         };
         for s in &file.speeds {
             s.rules(self);
+            // A frame's angular velocity keeps its name; a definition reads the rates only.
+            if file.angular_velocity_name(&s.name.value).is_some() {
+                self.error(
+                    Diagnostic::new(s.name.location, format!("speed name `{}` is taken: it names a component of a frame's angular velocity", s.name.value))
+                        .with_help(format!("choose another name, such as `w1`, and define it as `{}`", s.name.value)),
+                );
+            }
+            let mut ids = Vec::new();
+            identifiers(&s.value, &mut ids);
+            if let Some((other, at)) = ids
+                .iter()
+                .find(|(n, _)| self.sets.speeds.contains(n.as_str()))
+            {
+                self.error(
+                    Diagnostic::new(*at, format!("speed `{}` is defined through the speed `{other}`", s.name.value))
+                        .with_help("define each speed by the rates (`theta1_dot + theta2_dot`), not by other speeds"),
+                );
+            }
         }
         let (n, p) = (file.coordinates.len(), file.speeds.len());
         if n != p && !self.incomplete.has_section("coordinates") {

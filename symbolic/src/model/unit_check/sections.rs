@@ -94,6 +94,13 @@ impl Checker<'_> {
     // passes rely on this one order; split by section it would only be a longer list.
     pub(super) fn walk(&mut self) {
         let file = self.file;
+        // A speed's unit is its definition's (`omega_B_x`: 1/s).
+        self.speeds.clear();
+        for sp in &file.speeds {
+            self.top(&sp.value);
+            let unit = self.dim(&sp.value, &format!("speed `{}`", sp.name.value));
+            self.speeds.push((sp.name.value.clone(), unit));
+        }
         energy::units(file.written_energies(), self);
         point::units(&file.points, self);
         frame::units(&file.frames, self);
