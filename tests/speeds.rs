@@ -31,6 +31,9 @@ fn a_top_in_body_rates_lists_and_checks_kanes_equations() {
             "no line `{line}` in:\n{text}"
         );
     }
+    let out = eomgen_ok(&["equations", &top, "--latex"]);
+    let latex = String::from_utf8_lossy(&out.stdout);
+    assert!(latex.contains("\\dot{\\theta} = "), "{latex}");
     let out = eomgen_ok(&["equations", &top, "--json"]);
     let json: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
     assert_eq!(
@@ -104,5 +107,23 @@ fn a_speed_has_the_unit_of_its_definition() {
     assert!(
         err.contains("units.yaml:8:35: the x component of force `push` is m/s, but a force is N"),
         "{err}"
+    );
+}
+
+/// A speed with an offset prints its kinematic equation with it: `q' = W(q, t) (u - Z(q, t))`.
+#[test]
+fn the_kinematic_equations_name_an_offset() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let path = dir.path().join("belt.yaml");
+    std::fs::write(
+        &path,
+        "name: belt\nparameters: { m: 2, k: 5, v0: 0.7 }\ncoordinates: [x]\nspeeds: { u: x_dot + v0 }\npoints: { O: [0, 0], P: [x + v0*t, 0] }\nbodies: { ball: { mass: m, at: P } }\nforces: { pull: { at: P, vector: [-k*x, 0] } }\n",
+    )
+    .expect("written");
+    let out = eomgen_ok(&["equations", path.to_str().expect("a path")]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("q' = W(q, t) (u - Z(q, t)) (the kinematic equations) with\n  x' = u - v0\n"),
+        "{text}"
     );
 }

@@ -292,6 +292,16 @@ fn mistaken_speeds_are_located() {
     };
     let e = lowering_error(&planar("a: x_dot^2, b: y_dot", "x: 1"));
     assert_eq!(e, "3:14: speed `a` is not linear in the rates");
+    // Linear, though multiplying out leaves `√(2 + x)·√(2 + x)` apart from `2 + x`.
+    let file = eomgen_symbolic::model::load(
+        "m.yaml",
+        &planar(
+            "a: sqrt(2 + x)*(x_dot + sqrt(2 + x)*y_dot), b: y_dot",
+            "x: 1",
+        ),
+    )
+    .expect("loads");
+    assert!(SymbolicModel::from_file(&file).is_ok());
     for nonlinear in [
         "a: abs(x_dot), b: y_dot",
         "a: x_dot + sign(x_dot), b: y_dot",
@@ -308,8 +318,21 @@ fn mistaken_speeds_are_located() {
             "{nonlinear}: {errors:?}"
         );
     }
-    let e = load_error(&FREE_BODY.replace("  w3: omega_B_z", "  omega_B_x: omega_B_z"));
-    assert!(e.contains("22:3: speed name `omega_B_x` is taken"), "{e}");
+    let e = load_error(
+        &FREE_BODY
+            .replace("  w3: omega_B_z", "  omega_B_x: omega_B_z")
+            .replace("w3: 1 }", "omega_B_x: 1 }"),
+    );
+    assert_eq!(
+        e,
+        "22:3: speed name `omega_B_x` is taken: it names a component of a frame's angular velocity"
+    );
+    let quartic = "name: quartic\nparameters: { m: 2, b: 0.3 }\ncoordinates: [x]\nkinetic: m*x_dot^2/2 + b*x_dot^4\nspeeds: { v: 2*x_dot }\n";
+    let e = load_error(quartic);
+    assert!(
+        e.contains("5:11: generalized speeds need the kinematic form"),
+        "{e}"
+    );
     let e = load_error(&planar("a: x_dot, b: a + y_dot", "x: 1"));
     assert!(
         e.contains("3:24: speed `b` is defined through the speed `a`"),
@@ -351,40 +374,6 @@ fn mistaken_speeds_are_located() {
     );
 }
 
-/// Lagrange's `M` depends on the rates where `T` is not quadratic in them, and is carried
-/// into the speeds with them replaced: `T = m ẋ²/2 + b ẋ⁴` in `v = 2ẋ` gives `v̇ = 2ẍ`,
-/// `ẍ` of the same file in its rate, at 50 random states to 1e-12, and no rate is left in
-/// `M` or `F`.
-#[test]
-fn a_kinetic_energy_not_quadratic_in_the_rates_is_carried_whole() {
-    let rates = "name: quartic\nparameters: { m: 2, b: 0.3, k: 5 }\ncoordinates: [x]\nkinetic: m*x_dot^2/2 + b*x_dot^4\npotential: k*x^2/2\n";
-    let speeds = format!("{rates}speeds: {{ v: 2*x_dot }}\n");
-    let mut in_rates = lowered(rates);
-    let reference = Lagrange.derive(&mut in_rates);
-    let mut in_speeds = lowered(&speeds);
-    let carried = Lagrange.derive(&mut in_speeds);
-    assert!(free_of_retired(&in_speeds, &carried));
-    let mut rng = Xoshiro256PlusPlus::seed_from_u64(23);
-    for _ in 0..50 {
-        let (x, xd) = (rng.random_range(-2.0..2.0), rng.random_range(-2.0..2.0));
-        let xdd = accelerations(
-            &in_rates,
-            &reference,
-            &bindings(&in_rates, &[x], &[xd], 0.0),
-        );
-        let vd = accelerations(
-            &in_speeds,
-            &carried,
-            &bindings(&in_speeds, &[x], &[2.0 * xd], 0.0),
-        );
-        assert!(
-            relative(&vd, &[2.0 * xdd[0]]) < 1e-12,
-            "{vd:?} against {}",
-            2.0 * xdd[0]
-        );
-    }
-}
-
 /// A speed with an offset, `u = ẋ + v0` for a point at `x + v0 t` pulled by `−k x`:
 /// `u̇ = ẍ = −k x/m` from both derivations at 50 random states and times to 1e-13,
 /// no rate left in either, and `check` passes, its energy routes and power balance skipped
@@ -416,6 +405,21 @@ fn a_speed_with_an_offset_moves_as_its_rate() {
     assert!(report.passed(1e-9), "{summary:?}");
     assert!(
         summary.notes.iter().any(|n| n.contains("offset")),
+        "{summary:?}"
+    );
+    // A speed whose coefficient depends on `t`: `T(q, u)` then has no `t` where `T(q, q̇)`
+    // has, or the other way round; the routes that ask are skipped, and `check` passes.
+    let pendulum = "name: swing\nparameters: { m: 1, l: 1, g: 9.8, w: 2 }\ncoordinates: [q]\nspeeds: { u: (2 + sin(w*t))*q_dot }\npoints: { O: [0, 0], P: [l*sin(q), -l*cos(q)] }\nbodies: { bob: { mass: m, at: P } }\ngravity: [0, -g]\ninitial: { q: 1 }\n";
+    let file = eomgen_symbolic::model::load("m.yaml", pendulum).expect("loads");
+    let report =
+        eomgen_symbolic::mechanics::cross_check::check_model(&file, 50, 1).expect("checks");
+    let summary = report.summary(1e-9, false);
+    assert!(report.passed(1e-9), "{summary:?}");
+    assert!(
+        summary
+            .notes
+            .iter()
+            .any(|n| n.contains("depends on t (u = Y")),
         "{summary:?}"
     );
 }

@@ -592,7 +592,7 @@ fn sample_states(
     let mut power_rel: f64 = 0.0;
     // In speeds with an offset, `T(q, u)` says nothing of `T`'s degree in `q̇`: not tested,
     // the power balance skipped.
-    let mut quadratic = !model.speeds_have_offsets();
+    let mut quadratic = !model.speeds_hide_the_energy_form();
     let symbols = model.arena.symbols().to_vec();
     let defaults = defaults_by_symbol(model);
     let state_box = model.state_box();

@@ -60,14 +60,14 @@ pub fn energy_routes_skipped(model: &SymbolicModel) -> Option<&'static str> {
         Some(
             "energy and power routes skipped: with constraints, one energy equation does not determine the coordinates and the multipliers",
         )
+    } else if model.speeds_hide_the_energy_form() {
+        Some(
+            "energy and power routes skipped: a generalized speed has an offset Z(q, t) or a coefficient that depends on t (u = Y q̇ + Z), so T in the speeds shows neither its degree in q̇ nor its dependence on t",
+        )
     } else if model.arena.depends_on(model.kinetic, t) || model.arena.depends_on(model.potential, t)
     {
         Some(
             "energy and power routes skipped: T or V depends explicitly on t (a driven support works through its reaction force)",
-        )
-    } else if model.speeds_have_offsets() {
-        Some(
-            "energy and power routes skipped: a generalized speed has an offset Z(q, t) (u = Y q̇ + Z), so T in the speeds does not show whether it is a quadratic form in q̇",
         )
     } else if !kinetic_is_quadratic_in_rate(model) {
         Some(

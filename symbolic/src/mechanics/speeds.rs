@@ -121,7 +121,11 @@ pub(crate) fn switch(
         let rest = arena.sum(&rest);
         let rest = arena.expand(rest);
         let rates_in = |arena: &ExprArena, e: ExprId| old.iter().any(|t| arena.depends_on(e, t[1]));
-        if row.iter().any(|&c| rates_in(arena, c)) || rates_in(arena, rest) {
+        // Multiplying out may leave equal terms apart (`√(2 + x)·√(2 + x)` and `2 + x`): a
+        // rest that still reads the rates must then vanish at random states too.
+        let nonlinear = row.iter().any(|&c| rates_in(arena, c))
+            || (rates_in(arena, rest) && !vanishes(arena, &model.parameters, rest, d));
+        if nonlinear {
             let speed = &file.speeds[r];
             errors.push(
                 Diagnostic::new(speed.value.location, format!("speed `{}` is not linear in the rates", speed.name.value))
@@ -359,6 +363,44 @@ impl Speeds {
             forcing: carried_forcing,
         }
     }
+}
+
+/// Whether `rest` is 0 to rounding (1e-12 relative to `1 + |scale|`) at 20 random states
+/// (coordinates, rates and `t` in [−2, 2], parameters at their defaults) where it is finite,
+/// and at least one is.
+fn vanishes(
+    arena: &ExprArena,
+    parameters: &[super::ParameterInfo],
+    rest: ExprId,
+    scale: ExprId,
+) -> bool {
+    use crate::expr::SymbolKind;
+    use rand::{RngExt, SeedableRng};
+    let mut rng = rand::rngs::Xoshiro256PlusPlus::seed_from_u64(75);
+    let mut evaluator = crate::expr::eval::Evaluator::new(arena, &[rest, scale]);
+    let mut finite = 0;
+    for _ in 0..20 {
+        let mut bindings: Vec<f64> = (arena.symbols().iter())
+            .map(|s| match s.kind {
+                SymbolKind::Coordinate(_)
+                | SymbolKind::Velocity(_)
+                | SymbolKind::Retired
+                | SymbolKind::Time => rng.random_range(-2.0..2.0),
+                _ => 0.0,
+            })
+            .collect();
+        for p in parameters {
+            bindings[p.symbol.index()] = p.default;
+        }
+        let v = evaluator.eval(&bindings);
+        if v[0].is_finite() && v[1].is_finite() {
+            finite += 1;
+            if v[0].abs() > 1e-12 * (1.0 + v[1].abs()) {
+                return false;
+            }
+        }
+    }
+    finite > 0
 }
 
 /// `numerator / determinant`, multiplied out where the determinant is a product of factors

@@ -85,11 +85,11 @@ pub fn check_model(
         (&comparisons, &balance_set_of, &row_rel),
         &mut notes,
     );
-    let power_balance = if explicit_time {
-        notes.push("power balance skipped: T or V depends explicitly on t".to_string());
+    let power_balance = if model.speeds_hide_the_energy_form() {
+        notes.push("power balance skipped: a generalized speed has an offset Z(q, t) or a coefficient that depends on t (u = Y q̇ + Z), so T in the speeds shows neither its degree in q̇ nor its dependence on t".to_string());
         None
-    } else if model.speeds_have_offsets() {
-        notes.push("power balance skipped: a generalized speed has an offset Z(q, t) (u = Y q̇ + Z), so T in the speeds does not show whether it is a quadratic form in q̇".to_string());
+    } else if explicit_time {
+        notes.push("power balance skipped: T or V depends explicitly on t".to_string());
         None
     } else if !quadratic {
         notes.push("power balance skipped: T is not a quadratic form in the rates".to_string());

@@ -66,7 +66,8 @@ impl Checker<'_> {
     }
 
     // Rule (`speeds:`): one generalized speed per coordinate, each read where the rates may
-    // be; `initial:` gives the speeds or the rates, not both. The equations in speeds are
+    // be, defined by the rates (not other speeds) and not named as an angular velocity, in a
+    // model of the kinematic form; `initial:` gives the speeds or the rates, not both. The equations in speeds are
     // derived for holonomic systems without contacts (Kane and Levinson, ch. 6, for the
     // rest: constraints, contacts, balances and hand-written equations in speeds are not
     // supported).
@@ -81,15 +82,16 @@ impl Checker<'_> {
             if file.angular_velocity_name(&s.name.value).is_some() {
                 self.error(
                     Diagnostic::new(s.name.location, format!("speed name `{}` is taken: it names a component of a frame's angular velocity", s.name.value))
-                        .with_help(format!("choose another name, such as `w1`, and define it as `{}`", s.name.value)),
+                        .with_help("rename the speed: `omega_<frame>_<axis>` always reads the frame's angular velocity"),
                 );
             }
             let mut ids = Vec::new();
             identifiers(&s.value, &mut ids);
-            if let Some((other, at)) = ids
-                .iter()
-                .find(|(n, _)| self.sets.speeds.contains(n.as_str()))
-            {
+            // (A speed named as an angular velocity is reported above; the name reads the
+            // angular velocity here.)
+            if let Some((other, at)) = ids.iter().find(|(n, _)| {
+                self.sets.speeds.contains(n.as_str()) && file.angular_velocity_name(n).is_none()
+            }) {
                 self.error(
                     Diagnostic::new(*at, format!("speed `{}` is defined through the speed `{other}`", s.name.value))
                         .with_help("define each speed by the rates (`theta1_dot + theta2_dot`), not by other speeds"),
@@ -101,6 +103,14 @@ impl Checker<'_> {
             self.error(
                 Diagnostic::new(first.name.location, format!("the model has {n} coordinate{} but {p} speed{}: `speeds` gives one per coordinate", if n == 1 { "" } else { "s" }, if p == 1 { "" } else { "s" }))
                     .with_help("each speed is a combination of the rates, such as `w1: omega_B_x`; together they must determine every rate"),
+            );
+        }
+        if file.kinetic.is_some()
+            || (file.bodies.is_empty() && !self.incomplete.has_section("bodies"))
+        {
+            self.error(
+                Diagnostic::new(first.name.location, "generalized speeds need the kinematic form: bodies, and no written `kinetic:`")
+                    .with_help("Kane's equations in the speeds are projected on the bodies' partial velocities, and they check Lagrange's; write the bodies, points and frames instead of `kinetic:`"),
             );
         }
         let unsupported = [
