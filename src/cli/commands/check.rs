@@ -87,8 +87,10 @@ fn print_report(r: &CheckReport) {
                 None => "symbolically equal: not applicable",
             }
         };
+        // Kane's equations are in generalized speeds, whose rates the comparison solves for.
+        let accelerations = if c.b == "kane" { "u'" } else { "q''" };
         outln!(
-            "{} {a} vs {b}: relative residual of {b} at {a}'s q'' {residual}, the worst of {} states; {symbolic}",
+            "{} {a} vs {b}: relative residual of {b} at {a}'s {accelerations} {residual}, the worst of {} states; {symbolic}",
             mark(c.passed(TOLERANCE)),
             c.states,
             a = c.a,
