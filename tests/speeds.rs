@@ -9,6 +9,13 @@ fn fixture(name: &str) -> String {
     format!("{}/tests/fixtures/{name}", env!("CARGO_MANIFEST_DIR"))
 }
 
+/// `text` written as `name` in the temporary directory `dir`; its path.
+fn written(dir: &tempfile::TempDir, name: &str, text: &str) -> String {
+    let path = dir.path().join(name);
+    std::fs::write(&path, text).expect("written");
+    path.to_str().expect("a path").to_string()
+}
+
 /// The heavy top in body rates lists Euler's equations about its pivot (the closed form is
 /// checked at random states in `symbolic/tests/speeds.rs`; here, what is printed) and the
 /// kinematic equations of z-x-z angles; both derivations agree in `check`.
@@ -98,13 +105,12 @@ fn partial_velocities_are_with_respect_to_the_speeds() {
 #[test]
 fn a_speed_has_the_unit_of_its_definition() {
     let dir = tempfile::tempdir().expect("a temporary directory");
-    let path = dir.path().join("units.yaml");
-    std::fs::write(
-        &path,
+    let path = written(
+        &dir,
+        "units.yaml",
         "name: p\nunits: SI\nparameters: { m: 1.0 }  # kg\ncoordinates: [x]  # m\nspeeds: { v: x_dot }\npoints: { P: [x, 0] }\nbodies: { ball: { mass: m, at: P } }\nforces: { push: { at: P, vector: [v, 0] } }\n",
-    )
-    .expect("written");
-    let out = eomgen(&["check", path.to_str().expect("a path")]);
+    );
+    let out = eomgen(&["check", &path]);
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(
@@ -117,13 +123,12 @@ fn a_speed_has_the_unit_of_its_definition() {
 #[test]
 fn the_kinematic_equations_name_an_offset() {
     let dir = tempfile::tempdir().expect("a temporary directory");
-    let path = dir.path().join("belt.yaml");
-    std::fs::write(
-        &path,
+    let path = written(
+        &dir,
+        "belt.yaml",
         "name: belt\nparameters: { m: 2, k: 5, v0: 0.7 }\ncoordinates: [x]\nspeeds: { u: x_dot + v0 }\npoints: { O: [0, 0], P: [x + v0*t, 0] }\nbodies: { ball: { mass: m, at: P } }\nforces: { pull: { at: P, vector: [-k*x, 0] } }\n",
-    )
-    .expect("written");
-    let out = eomgen_ok(&["equations", path.to_str().expect("a path")]);
+    );
+    let out = eomgen_ok(&["equations", &path]);
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(
         text.contains("q' = W(q, t) (u - Z(q, t)) (the kinematic equations) with\n  x' = u - v0\n"),

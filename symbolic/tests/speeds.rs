@@ -185,27 +185,10 @@ fn the_kinematic_equations_give_back_the_speeds() {
     }
 }
 
-/// `source` with its `speeds:` block and the speeds' initial values left out (the same
-/// mechanism in the coordinates' rates).
+/// `source` with its `speeds:` block and its `initial:` (the speeds' values) left out: the
+/// same mechanism in the coordinates' rates.
 fn without_speeds(source: &str) -> String {
-    let mut out = String::new();
-    let mut in_speeds = false;
-    for line in source.lines() {
-        if line.starts_with("speeds:") {
-            in_speeds = true;
-            continue;
-        }
-        if in_speeds && line.starts_with("  ") {
-            continue;
-        }
-        in_speeds = false;
-        if line.starts_with("initial:") {
-            continue;
-        }
-        out.push_str(line);
-        out.push('\n');
-    }
-    out
+    strip_section(&strip_section(source, "speeds:"), "initial:")
 }
 
 /// A planar chain in the upper arm's rate and the elbow's (relative) rate, with the bundled

@@ -231,12 +231,7 @@ pub fn equations_text(model: &SymbolicModel, eom: &EquationsOfMotion) -> String 
         "q''"
     } else {
         let _ = writeln!(s, "u = [{}]", e.speeds.join(", "));
-        let form = if model
-            .speeds
-            .iter()
-            .flat_map(|s| &s.offsets)
-            .any(|z| !model.arena.is_zero(*z))
-        {
+        let form = if model.speeds_have_offsets() {
             "q' = W(q, t) (u - Z(q, t))"
         } else {
             "q' = W(q, t) u"

@@ -509,15 +509,15 @@ impl ExprArena {
     /// Makes the speeds `names` (one per coordinate) the state's second half: declares each
     /// speed `uᵣ` (kind [`SymbolKind::Velocity`]) and its rate `uᵣ_dot`
     /// ([`SymbolKind::Acceleration`]), puts them in the coordinates' triples in place of
-    /// `q̇ᵣ` and `q̈ᵣ`, which become [`SymbolKind::Retired`]; returns the old `[q̇, q̈]` and the
-    /// new `[u, u̇]` expressions per coordinate. The caller then gives the kinematic
+    /// `q̇ᵣ` and `q̈ᵣ`, which become [`SymbolKind::Retired`]; returns the new `[u, u̇]`
+    /// expressions per coordinate. The caller then gives the kinematic
     /// equations ([`Self::set_coordinate_rates`]) and replaces `q̇` and `q̈` in every
     /// expression it keeps.
     ///
     /// # Panics
-    /// If `names` is not one per coordinate or a name is declared already (the model checks
-    /// reject both).
-    pub fn switch_to_speeds(&mut self, names: &[String]) -> Vec<([ExprId; 2], [ExprId; 2])> {
+    /// If `names` is not one per coordinate or a name (or its `_dot`) is declared already
+    /// (the model checks reject both, and the model's switch says so before calling).
+    pub fn switch_to_speeds(&mut self, names: &[String]) -> Vec<[ExprId; 2]> {
         assert_eq!(
             names.len(),
             self.coordinates.len(),
@@ -537,8 +537,7 @@ impl ExprArena {
             let ud = self.declare(&format!("{name}_dot"), SymbolKind::Acceleration(i as u32));
             self.coordinates[i][1] = u;
             self.coordinates[i][2] = ud;
-            let old = [qd, qdd].map(|s| self.symbol_expr(s));
-            out.push((old, [u, ud].map(|s| self.symbol_expr(s))));
+            out.push([u, ud].map(|s| self.symbol_expr(s)));
         }
         self.dt_memo.clear();
         out

@@ -337,11 +337,17 @@ impl SymbolicModel {
     /// `T`'s degree in `q̇` nor whether `T(q, q̇)` depends on `t`, and the energy routes and
     /// the power balance, which ask that, do not apply.
     pub fn speeds_hide_the_energy_form(&self) -> bool {
-        let Some(speeds) = &self.speeds else {
-            return false;
-        };
-        speeds.offsets.iter().any(|z| !self.arena.is_zero(*z))
-            || (speeds.inverse.iter()).any(|w| self.arena.depends_on(*w, self.time_id))
+        self.speeds_have_offsets()
+            || (self.speeds.iter())
+                .flat_map(|s| &s.inverse)
+                .any(|w| self.arena.depends_on(*w, self.time_id))
+    }
+
+    /// Whether the model is in generalized speeds with an offset `Z(q, t) ≠ 0` in one of them.
+    pub fn speeds_have_offsets(&self) -> bool {
+        (self.speeds.iter())
+            .flat_map(|s| &s.offsets)
+            .any(|z| !self.arena.is_zero(*z))
     }
 
     /// The time symbol id.

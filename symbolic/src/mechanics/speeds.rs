@@ -34,7 +34,7 @@ use rustc_hash::FxHashMap;
 use super::frames::{Vector3, cross, tensor_times};
 use super::lower::{LoadInfo, Speeds};
 use super::momentum::{LoadForces, dot, linear_in_accelerations, load_forces};
-use super::{EquationsOfMotion, Formulation, Lagrange, SymbolicModel};
+use super::{EquationsOfMotion, Formulation, Lagrange, MomentumBalance, SymbolicModel};
 use crate::expr::{ExprArena, ExprId, Node, SymbolId};
 use crate::model::diagnostic::Diagnostic;
 use crate::model::file::ModelFile;
@@ -75,12 +75,15 @@ impl Formulation for Kane {
         "kane"
     }
 
-    /// # Panics
-    /// For a model without speeds ([`Kane::applies_to`]).
+    /// For a model without speeds, [`MomentumBalance`]'s equations.
     fn derive(&self, model: &mut SymbolicModel) -> EquationsOfMotion {
         kane(model)
     }
 }
+
+/// The most speeds a model may have: the minors of their coefficients are indexed by bit sets
+/// of 64 rows and columns (and a dense matrix of that size would not be expanded anyway).
+pub(crate) const MAX_SPEEDS: usize = 64;
 
 /// Switches `model`'s state to the speeds of `file`, whose definitions (in `q`, `q̇`, `t`, as
 /// lowered) are `definitions` and whose `initial:` values (where the file gives speeds rather
@@ -96,6 +99,16 @@ pub(crate) fn switch(
     file: &ModelFile,
 ) -> Result<SymbolicModel, Vec<Diagnostic>> {
     let n = model.num_dofs();
+    if n > MAX_SPEEDS {
+        let first = &file.speeds[0];
+        return Err(vec![
+            Diagnostic::new(
+                first.name.location,
+                format!("the model has {n} speeds; at most {MAX_SPEEDS} are derived"),
+            )
+            .with_help("write a model of this size in the coordinates' rates (remove `speeds`)"),
+        ]);
+    }
     // Bounded as every derivation is (a file of deeply nested rotations); the switch below
     // multiplies out no more than the partial velocities.
     super::limit_derivation(&mut model);
@@ -151,6 +164,22 @@ pub(crate) fn switch(
         .map(|&a| over_determinant(arena, a, determinant))
         .collect();
 
+    // The model checks keep each speed's name and its `_dot` apart from every other name.
+    if let Some(taken) = (file.speeds.iter()).find(|sp| {
+        let name = &sp.name.value;
+        arena.symbol_id(name).is_some() || arena.symbol_id(&format!("{name}_dot")).is_some()
+    }) {
+        return Err(vec![
+            Diagnostic::new(
+                taken.name.location,
+                format!(
+                    "speed name `{}` (or its rate `{}_dot`) is taken by another name of the model",
+                    taken.name.value, taken.name.value
+                ),
+            )
+            .with_help("rename the speed"),
+        ]);
+    }
     let pairs = arena.switch_to_speeds(
         &file
             .speeds
@@ -158,8 +187,8 @@ pub(crate) fn switch(
             .map(|s| s.name.value.clone())
             .collect::<Vec<_>>(),
     );
-    let u: Vec<ExprId> = pairs.iter().map(|(_, [u, _])| *u).collect();
-    for (c, (_, new)) in model.coordinates.iter_mut().zip(&pairs) {
+    let u: Vec<ExprId> = pairs.iter().map(|[u, _]| *u).collect();
+    for (c, new) in model.coordinates.iter_mut().zip(&pairs) {
         c[1] = new[0];
         c[2] = new[1];
     }
@@ -192,13 +221,9 @@ pub(crate) fn switch(
     // and the bodies' angular velocities by their forms in `u` (partial velocities divided
     // out exactly).
     let mut values: FxHashMap<SymbolId, ExprId> = FxHashMap::default();
-    for (j, (old, _)) in pairs.iter().enumerate() {
-        for (k, &e) in old.iter().enumerate() {
-            let Node::Symbol(s) = *arena.node(e) else {
-                unreachable!("a coordinate's rate is a symbol")
-            };
-            values.insert(s, [speeds.kinematic_equations[j], accelerations[j]][k]);
-        }
+    for (j, s) in old.iter().enumerate() {
+        values.insert(s[1], speeds.kinematic_equations[j]);
+        values.insert(s[2], accelerations[j]);
     }
     let mut memo: FxHashMap<ExprId, ExprId> = FxHashMap::default();
     for (r, &d) in definitions.iter().enumerate() {
@@ -419,13 +444,13 @@ fn over_determinant(arena: &mut ExprArena, numerator: ExprId, determinant: ExprI
 /// `det(Y)` and `adj(Y)` (row-major, `adj(Y)ⱼᵣ` the cofactor of `Yᵣⱼ`) of the `n × n`
 /// row-major `y`, each multiplied out, by cofactor expansion along the first row of each
 /// minor with every minor computed once (by its rows and columns), skipping zero entries: the
-/// speeds' coefficient matrices are small or sparse (`n` ≤ 64 is asserted).
+/// speeds' coefficient matrices are small or sparse (at most [`MAX_SPEEDS`], one bit each).
 fn determinant_and_adjugate(
     arena: &mut ExprArena,
     y: &[ExprId],
     n: usize,
 ) -> (ExprId, Vec<ExprId>) {
-    assert!(n <= 64, "at most 64 speeds");
+    debug_assert!(n <= MAX_SPEEDS, "checked by `switch`");
     let all: u64 = if n == 64 { u64::MAX } else { (1u64 << n) - 1 };
     let mut memo: FxHashMap<(u64, u64), ExprId> = FxHashMap::default();
     let det = minor(arena, y, n, (all, all), &mut memo);
@@ -477,10 +502,13 @@ fn minor(
 
 /// Kane's equations in the speeds of `model` (see the module docs), `M u̇ = F`.
 ///
-/// # Panics
-/// If `model` has no speeds (a programmer error: [`Kane::applies_to`] is checked first).
+/// Without speeds, [`MomentumBalance`]'s equations (the same projection on the rates'
+/// partial velocities).
 fn kane(model: &mut SymbolicModel) -> EquationsOfMotion {
-    let speeds = model.speeds.clone().expect("a model with speeds");
+    // In the rates, Kane's equations are the momentum balance on their partial velocities.
+    let Some(speeds) = model.speeds.clone() else {
+        return MomentumBalance.derive(model);
+    };
     let n = model.num_dofs();
     let symbols: Vec<[SymbolId; 3]> = (0..n).map(|i| model.coordinate_symbols(i)).collect();
     let time = model.time_symbol();
