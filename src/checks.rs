@@ -265,8 +265,7 @@ fn state_value(
     t: f64,
     y: &[f64],
 ) -> Result<f64, String> {
-    let coordinates = model.description().coordinate_names();
-    let n = coordinates.len();
+    let description = model.description();
     eval_expr(e, &|name| {
         if name == "t" {
             return Some(t);
@@ -274,14 +273,7 @@ fn state_value(
         if let Some(v) = parameters(name) {
             return Some(v);
         }
-        if let Some(i) = coordinates.iter().position(|c| *c == name) {
-            return Some(y[i]);
-        }
-        let base = name.strip_suffix("_dot")?;
-        coordinates
-            .iter()
-            .position(|c| *c == base)
-            .map(|i| y[n + i])
+        description.state_index(name).map(|i| y[i])
     })
     .map_err(|d| d.message)
 }
@@ -540,14 +532,8 @@ fn final_state_rows(
                     .map(|(_, y)| y.to_vec())
                     .ok_or_else(|| format!("the integration stopped before t = {t}"))
             });
-            let coordinates = model.description().coordinate_names();
-            let n = coordinates.len();
             for (k, e) in check.values.iter() {
-                let index = coordinates.iter().position(|c| *c == k).or_else(|| {
-                    k.strip_suffix("_dot")
-                        .and_then(|b| coordinates.iter().position(|c| *c == b))
-                        .map(|i| n + i)
-                });
+                let index = model.description().state_index(k);
                 let computed = state.clone().and_then(|y| {
                     index
                         .map(|i| y[i])

@@ -343,25 +343,17 @@ pub fn set_initial_values(
     for s in assignments.iter().flat_map(|s| split_list(s.as_ref())) {
         let (name, text) = split_assignment(s, "--init")?;
         let value = evaluate(text, &format!("--init {name}"), &parameter_lookup(model))?;
-        let index = coordinates
-            .iter()
-            .position(|c| *c == name)
-            .or_else(|| {
-                coordinates
-                    .iter()
-                    .position(|c| name.strip_suffix("_dot") == Some(c))
-                    .map(|i| n + i)
-            })
-            .ok_or_else(|| {
-                let rates: Vec<String> = coordinates.iter().map(|c| format!("{c}_dot")).collect();
-                ExpressionError::UnknownCoordinate {
-                    option: "--init".to_string(),
-                    name: name.to_string(),
-                    model: model.description().name.to_string(),
-                    coordinates: coordinates.join(", "),
-                    rates: rates.join(", "),
-                }
-            })?;
+        let description = model.description();
+        let index = description.state_index(name).ok_or_else(|| {
+            let rates: Vec<String> = (n..2 * n).map(|i| description.state_name(i)).collect();
+            ExpressionError::UnknownCoordinate {
+                option: "--init".to_string(),
+                name: name.to_string(),
+                model: model.description().name.to_string(),
+                coordinates: coordinates.join(", "),
+                rates: rates.join(", "),
+            }
+        })?;
         y[index] = value;
     }
     Ok(())
@@ -592,7 +584,7 @@ fn resolve(
     }
     for (i, c) in model.description().coordinate_names().iter().enumerate() {
         known.push((c.to_string(), Source::State(i)));
-        known.push((format!("{c}_dot"), Source::State(n + i)));
+        known.push((model.description().state_name(n + i), Source::State(n + i)));
         known.push((format!("{c}_ddot"), Source::Acceleration(i)));
     }
     for (i, c) in model.description().constraint_names().iter().enumerate() {

@@ -120,8 +120,6 @@ pub fn evaluate_outputs(
 ) -> Result<Vec<OutputSeries>, OutputError> {
     let description = model.description();
     let parameters = parameter_lookup(model);
-    let coordinates = description.coordinate_names();
-    let n = coordinates.len();
     let mut series = Vec::with_capacity(description.outputs.len());
     for output in description.outputs.iter() {
         let (name, value) = (output.name.to_string(), output.value.to_string());
@@ -148,14 +146,7 @@ pub fn evaluate_outputs(
                 if let Some(v) = parameters(k) {
                     return Some(v);
                 }
-                if let Some(i) = coordinates.iter().position(|c| *c == k) {
-                    return Some(y[i]);
-                }
-                let base = k.strip_suffix("_dot")?;
-                coordinates
-                    .iter()
-                    .position(|c| *c == base)
-                    .map(|i| y[n + i])
+                description.state_index(k).map(|i| y[i])
             })
             .map_err(|d| expression_error(d.message))?;
             if !v.is_finite() {

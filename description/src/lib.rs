@@ -50,6 +50,11 @@ pub struct ModelDescription {
     pub summary: Text,
     /// Names of the generalized coordinates `q`, in order (length `n`).
     pub coordinates: List<Text>,
+    /// The generalized speeds' names (`speeds:`, one per coordinate), empty for a model in
+    /// the coordinates' rates. With speeds, the state is `y = (q, u)` rather than `(q, q̇)`,
+    /// and `q̇ = W(q, t) (u − Z(q, t))` comes from the model's
+    /// `coordinate_rates` (Kane and Levinson, *Dynamics: Theory and Applications*, §2.12).
+    pub speeds: List<Text>,
     /// The parameters, in file order, with their default values.
     pub parameters: List<Parameter>,
     /// Names of the model's points, in file order (empty for the energy form).
@@ -158,6 +163,7 @@ impl ModelDescription {
         name: Cow::Borrowed(""),
         summary: Cow::Borrowed(""),
         coordinates: Cow::Borrowed(&[]),
+        speeds: Cow::Borrowed(&[]),
         parameters: Cow::Borrowed(&[]),
         points: Cow::Borrowed(&[]),
         draw_lines: Cow::Borrowed(&[]),
@@ -198,16 +204,39 @@ impl ModelDescription {
     }
 
     /// The name of state entry `i` of `y = (q, q̇)`: a coordinate (`x`) for `i < n`, its rate
-    /// (`x_dot`) for `n ≤ i < 2n`, else the index.
+    /// (`x_dot`) for `n ≤ i < 2n`, else the index. With generalized speeds (`y = (q, u)`),
+    /// entry `n + i` is speed `i`'s name.
     pub fn state_name(&self, i: usize) -> String {
         let n = self.coordinates.len();
         match self.coordinates.get(i) {
             Some(c) => c.to_string(),
-            None => match self.coordinates.get(i - n) {
-                Some(c) => format!("{c}_dot"),
-                None => i.to_string(),
+            None => match (self.speeds.get(i - n), self.coordinates.get(i - n)) {
+                (Some(u), _) => u.to_string(),
+                (None, Some(c)) => format!("{c}_dot"),
+                (None, None) => i.to_string(),
             },
         }
+    }
+
+    /// The index in `y` of a state entry named as [`Self::state_name`] names it: a coordinate
+    /// (`i`), then its rate (`x_dot`, `n + i`) or, with generalized speeds, a speed (`n + i`;
+    /// a rate `x_dot` is then not in the state and has no index).
+    pub fn state_index(&self, name: &str) -> Option<usize> {
+        let n = self.coordinates.len();
+        (self.coordinates.iter().position(|c| c == name)).or_else(|| {
+            let second = match self.has_speeds() {
+                true => self.speeds.iter().position(|u| u == name),
+                false => name
+                    .strip_suffix("_dot")
+                    .and_then(|c| self.coordinates.iter().position(|x| x == c)),
+            };
+            second.map(|i| n + i)
+        })
+    }
+
+    /// Whether the state is in generalized speeds, `y = (q, u)` ([`Self::speeds`]).
+    pub fn has_speeds(&self) -> bool {
+        !self.speeds.is_empty()
     }
 
     /// The parameters' names, in file order.

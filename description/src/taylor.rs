@@ -462,6 +462,10 @@ pub enum TaylorUnsupported {
         /// The stabilisation's name.
         name: Cow<'static, str>,
     },
+    /// The state is in generalized speeds, `(q, u)`: the recurrences take the coordinates'
+    /// rates as the state's second half, and have no series of the kinematic equations
+    /// `q̇ = W(q, t) (u − Z(q, t))`.
+    Speeds,
 }
 
 impl std::fmt::Display for TaylorUnsupported {
@@ -493,6 +497,11 @@ impl std::fmt::Display for TaylorUnsupported {
                 "its constraints can be left as they are or projected after each step \
                  (stabilisation `none` or `projection`), not stabilised by `{name}`, whose \
                  terms the recurrences do not have"
+            ),
+            TaylorUnsupported::Speeds => write!(
+                f,
+                "the state is in generalized speeds, and the recurrences have no series of \
+                 the kinematic equations q' = W(q, t) (u - Z(q, t)) (take an explicit method)"
             ),
         }
     }

@@ -77,7 +77,7 @@ pub struct LoadOptions {
     pub eager_taylor: bool,
 }
 
-/// The functions of a model: the first fifteen in the order of [`ModelProgram::functions`],
+/// The functions of a model: the first sixteen in the order of [`ModelProgram::functions`],
 /// then the Jacobians in the order of
 /// [`JacobianProgram::functions`](eomgen_symbolic::codegen::program::JacobianProgram::functions).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -97,9 +97,11 @@ enum Routine {
     ContactJacobian = 12,
     ContactCoefficients = 13,
     SupportChanges = 14,
-    ForcingJacobianQ = 15,
-    ForcingJacobianQdot = 16,
-    MassMatrixProductJacobian = 17,
+    CoordinateRates = 15,
+    ForcingJacobianQ = 16,
+    ForcingJacobianQdot = 17,
+    MassMatrixProductJacobian = 18,
+    CoordinateRatesJacobian = 19,
 }
 
 /// Index of the first Jacobian routine.
@@ -595,6 +597,42 @@ impl DynMechanicalSystem for JitModel {
             ..self.inputs(q, &[], t)
         };
         self.run(Routine::MassMatrixProductJacobian, inputs, out, &mut []);
+    }
+    fn coordinate_rates(&self, q: &[f64], qdot: &[f64], t: f64, out: &mut [f64]) {
+        if !self.code.program.description.has_speeds() {
+            let n = self.num_dofs();
+            out[..n].copy_from_slice(&qdot[..n]);
+            return;
+        }
+        self.run(
+            Routine::CoordinateRates,
+            self.inputs(q, qdot, t),
+            out,
+            &mut [],
+        );
+    }
+    fn coordinate_rates_jacobian(
+        &self,
+        q: &[f64],
+        qdot: &[f64],
+        t: f64,
+        d_q: &mut [f64],
+        d_u: &mut [f64],
+    ) {
+        let n = self.num_dofs();
+        if !self.code.program.description.has_speeds() {
+            d_q[..n * n].fill(0.0);
+            d_u[..n * n].fill(0.0);
+            (0..n).for_each(|i| d_u[i + i * n] = 1.0);
+            return;
+        }
+        // Every entry is written: a zero entry is a constant of the tape.
+        self.run(
+            Routine::CoordinateRatesJacobian,
+            self.inputs(q, qdot, t),
+            d_q,
+            d_u,
+        );
     }
     fn kinetic_energy(&self, q: &[f64], qdot: &[f64], t: f64) -> f64 {
         let mut out = [0.0];

@@ -132,6 +132,32 @@ pub trait DynMechanicalSystem {
         out: &mut [f64],
     );
 
+    /// [`MechanicalSystem::coordinate_rates`]: `q̇` (length `n`) into `out`; the default
+    /// copies `qdot` (a model in the coordinates' rates).
+    fn coordinate_rates(&self, q: &[f64], qdot: &[f64], t: f64, out: &mut [f64]) {
+        let _ = (q, t);
+        let n = self.num_dofs();
+        out[..n].copy_from_slice(&qdot[..n]);
+    }
+    /// [`MechanicalSystem::coordinate_rates_jacobian`]: `∂q̇/∂q` into `d_q` and `∂q̇/∂u`
+    /// into `d_u` (`n × n`, column-major each); the default writes `0` and `I`.
+    fn coordinate_rates_jacobian(
+        &self,
+        q: &[f64],
+        qdot: &[f64],
+        t: f64,
+        d_q: &mut [f64],
+        d_u: &mut [f64],
+    ) {
+        let _ = (q, qdot, t);
+        let n = self.num_dofs();
+        d_q[..n * n].fill(0.0);
+        d_u[..n * n].fill(0.0);
+        for i in 0..n {
+            d_u[i + i * n] = 1.0;
+        }
+    }
+
     /// [`MechanicalSystem::taylor`].
     ///
     /// # Errors
@@ -228,6 +254,26 @@ impl<S: MechanicalSystem<N>, const N: usize> DynMechanicalSystem for StaticSyste
             .0
             .mass_matrix_product_jacobian(&vector::<N>(q), t, &vector::<N>(a));
         out[..N * N].copy_from_slice(j.as_slice());
+    }
+    fn coordinate_rates(&self, q: &[f64], qdot: &[f64], t: f64, out: &mut [f64]) {
+        let rates = self
+            .0
+            .coordinate_rates(&vector::<N>(q), &vector::<N>(qdot), t);
+        out[..N].copy_from_slice(rates.as_slice());
+    }
+    fn coordinate_rates_jacobian(
+        &self,
+        q: &[f64],
+        qdot: &[f64],
+        t: f64,
+        d_q: &mut [f64],
+        d_u: &mut [f64],
+    ) {
+        let (a, b) = self
+            .0
+            .coordinate_rates_jacobian(&vector::<N>(q), &vector::<N>(qdot), t);
+        d_q[..N * N].copy_from_slice(a.as_slice());
+        d_u[..N * N].copy_from_slice(b.as_slice());
     }
     fn kinetic_energy(&self, q: &[f64], qdot: &[f64], t: f64) -> f64 {
         self.0

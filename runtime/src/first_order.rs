@@ -42,6 +42,9 @@ pub struct FirstOrder<S, const N: usize> {
     pub events: Vec<EventSpec>,
     /// Buffers of the Taylor series ([`crate::taylor`]), allocated on first use.
     taylor: TaylorWorkspace,
+    /// Whether the state is in generalized speeds (`y = [q; u]`, `q̇` from
+    /// [`MechanicalSystem::coordinate_rates`]).
+    speeds: bool,
 }
 
 impl<S: MechanicalSystem<N>, const N: usize> FirstOrder<S, N> {
@@ -54,12 +57,14 @@ impl<S: MechanicalSystem<N>, const N: usize> FirstOrder<S, N> {
         let m = description.constraints.len();
         let holonomic = description.holonomic_constraints;
         let events = description.events.to_vec();
+        let speeds = description.has_speeds();
         Self {
             system,
             stabilization: Stabilization::None,
             constraints: ConstraintWorkspace::new(N, m, holonomic),
             events,
             taylor: TaylorWorkspace::new(),
+            speeds,
         }
     }
 
@@ -158,7 +163,15 @@ impl<S: MechanicalSystem<N>, const N: usize> OdeSystem for FirstOrder<S, N> {
             }
             qdd
         };
-        dy[..N].copy_from_slice(qdot.as_slice());
+        if self.speeds {
+            let rates = self.system.coordinate_rates(&q, &qdot, t);
+            dy[..N].copy_from_slice(rates.as_slice());
+            if let Some(i) = rates.iter().position(|v| !v.is_finite()) {
+                return Err(RhsError::NonFinite { index: i });
+            }
+        } else {
+            dy[..N].copy_from_slice(qdot.as_slice());
+        }
         dy[N..2 * N].copy_from_slice(qdd.as_slice());
         Ok(())
     }
@@ -190,6 +203,9 @@ impl<S: MechanicalSystem<N>, const N: usize> OdeSystem for FirstOrder<S, N> {
     ///         [ ∂q̈/∂q    ∂q̈/∂q̇   ]
     /// ```
     ///
+    /// In generalized speeds the upper block row is
+    /// [`MechanicalSystem::coordinate_rates_jacobian`], `[∂q̇/∂q  W]`.
+    ///
     /// A constrained system returns `Ok(false)`: its `q̈` comes from the KKT system, whose
     /// derivative needs `∂J/∂q` and `∂γ/∂(q, q̇)`, which are not generated; the implicit
     /// methods then difference `F`.
@@ -209,11 +225,15 @@ impl<S: MechanicalSystem<N>, const N: usize> OdeSystem for FirstOrder<S, N> {
                 jac[N + i + (N + j) * dim] = d_qdot[(i, j)];
             }
         }
+        if self.speeds {
+            let (rates_q, rates_u) = self.system.coordinate_rates_jacobian(&q, &qdot, t);
+            coordinate_rate_rows(N, rates_q.as_slice(), rates_u.as_slice(), jac)?;
+        }
         Ok(true)
     }
 
     fn second_order_dim(&self) -> Option<usize> {
-        Some(N)
+        (!self.speeds).then_some(N)
     }
 
     fn event_specs(&self) -> &[EventSpec] {
@@ -309,6 +329,8 @@ pub struct DynFirstOrder<S> {
     /// The envelope indices of `solve_spd_in_place` (`2n`).
     envelope: Vec<usize>,
     zeros: Vec<f64>,
+    /// Whether the state is in generalized speeds (`y = [q; u]`).
+    speeds: bool,
 }
 
 impl<S: DynMechanicalSystem> DynFirstOrder<S> {
@@ -319,6 +341,7 @@ impl<S: DynMechanicalSystem> DynFirstOrder<S> {
         let m = description.constraints.len();
         let holonomic = description.holonomic_constraints;
         let events = description.events.to_vec();
+        let speeds = description.has_speeds();
         Self {
             system,
             stabilization: Stabilization::None,
@@ -331,6 +354,7 @@ impl<S: DynMechanicalSystem> DynFirstOrder<S> {
             envelope: vec![0; 2 * n],
             zeros: vec![0.0; n],
             taylor: TaylorWorkspace::new(),
+            speeds,
         }
     }
 
@@ -464,12 +488,60 @@ impl<S: DynMechanicalSystem> DynFirstOrder<S> {
     }
 }
 
+impl<S: DynMechanicalSystem> DynFirstOrder<S> {
+    /// The right-hand side `ẏ = [q̇; u̇]` of a model in generalized speeds (unconstrained: the
+    /// rules refuse speeds beside constraints): `q̇` from the kinematic equations
+    /// ([`DynMechanicalSystem::coordinate_rates`]), `u̇ = M⁻¹F`.
+    fn rhs_in_speeds(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), RhsError> {
+        let n = self.n;
+        let (q, u) = (&y[..n], &y[n..2 * n]);
+        let (rates, acceleration) = dy.split_at_mut(n);
+        self.generalized_accelerations(q, u, t, acceleration)?;
+        self.system.coordinate_rates(q, u, t, rates);
+        match rates.iter().position(|v| !v.is_finite()) {
+            Some(i) => Err(RhsError::NonFinite { index: i }),
+            None => Ok(()),
+        }
+    }
+}
+
+/// Writes the upper block row `[∂q̇/∂q  ∂q̇/∂u]` of a first-order Jacobian (`jac`, `2n × 2n`
+/// column-major) from the kinematic equations' Jacobians (`n × n` column-major each).
+///
+/// # Errors
+/// [`RhsError::JacobianNonFinite`] naming the first row with an entry that is not finite
+/// (at a singularity of the speeds' kinematic equations, such as gimbal lock).
+fn coordinate_rate_rows(
+    n: usize,
+    rates_q: &[f64],
+    rates_u: &[f64],
+    jac: &mut [f64],
+) -> Result<(), RhsError> {
+    let dim = 2 * n;
+    for j in 0..n {
+        for i in 0..n {
+            jac[i + j * dim] = rates_q[i + j * n];
+            jac[i + (n + j) * dim] = rates_u[i + j * n];
+        }
+    }
+    let bad = (0..n).find(|&i| {
+        (0..n).any(|j| !(rates_q[i + j * n].is_finite() && rates_u[i + j * n].is_finite()))
+    });
+    match bad {
+        Some(row) => Err(RhsError::JacobianNonFinite { row }),
+        None => Ok(()),
+    }
+}
+
 impl<S: DynMechanicalSystem> OdeSystem for DynFirstOrder<S> {
     fn dim(&self) -> usize {
         2 * self.n
     }
 
     fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), RhsError> {
+        if self.speeds {
+            return self.rhs_in_speeds(t, y, dy);
+        }
         if self.constraints.is_empty() {
             // The sizes of most mechanisms, with the matrices on the stack and the solve of
             // `FirstOrder` (the same operations as `solve_spd_in_place`): on the double
@@ -522,11 +594,22 @@ impl<S: DynMechanicalSystem> OdeSystem for DynFirstOrder<S> {
                 jac[n + i + (n + j) * dim] = d_qdot[(i, j)];
             }
         }
+        if self.speeds {
+            let (mut rates_q, mut rates_u) = (vec![0.0; n * n], vec![0.0; n * n]);
+            self.system.coordinate_rates_jacobian(
+                &y[..n],
+                &y[n..2 * n],
+                t,
+                &mut rates_q,
+                &mut rates_u,
+            );
+            coordinate_rate_rows(n, &rates_q, &rates_u, jac)?;
+        }
         Ok(true)
     }
 
     fn second_order_dim(&self) -> Option<usize> {
-        Some(self.n)
+        (!self.speeds).then_some(self.n)
     }
 
     fn event_specs(&self) -> &[EventSpec] {

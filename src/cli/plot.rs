@@ -132,10 +132,7 @@ pub fn time_histories(
     let mut panels: Vec<Series> = Vec::with_capacity(indices.len());
     for &i in &indices {
         if i < 2 * n {
-            let name = match i < n {
-                true => names[i].to_string(),
-                false => format!("{}_dot", names[i - n]),
-            };
+            let name = d.state_name(i);
             let points = solution.iter().map(|(t, y)| (t, y[i])).collect();
             panels.push(Series { name, points });
             continue;

@@ -194,7 +194,8 @@ const MAX_PANELS: usize = 12;
 /// # Errors
 /// A usage error naming a name that is neither a coordinate, a rate nor an output.
 fn shown_components(model: &dyn ModelInfo, names: Option<&str>) -> Result<Vec<usize>, CliError> {
-    let coordinates = model.description().coordinate_names();
+    let description = model.description();
+    let coordinates = description.coordinate_names();
     let n = coordinates.len();
     let Some(names) = names else {
         if n > MAX_PANELS {
@@ -226,9 +227,10 @@ fn shown_components(model: &dyn ModelInfo, names: Option<&str>) -> Result<Vec<us
         .split(',')
         .map(str::trim)
         .map(|name| {
-            let rate = name.strip_suffix("_dot");
+            let rate = name.strip_suffix("_dot").filter(|_| !description.has_speeds());
             (coordinates.iter().position(|c| *c == name))
                 .or_else(|| rate.and_then(|r| coordinates.iter().position(|c| *c == r)).map(|i| n + i))
+                .or_else(|| description.speeds.iter().position(|u| *u == name).map(|i| n + i))
                 .or_else(|| outputs.iter().position(|o| *o == name).map(|k| 2 * n + k))
                 .ok_or_else(|| {
                     CliError::usage(format!(
@@ -437,7 +439,7 @@ fn print_summary(
             outln!(
                 "           {name:>12} = {:>22.15e}   {:>16} = {:>22.15e}",
                 num(y[i]),
-                format!("{name}_dot"),
+                model.description().state_name(n + i),
                 num(y[n + i])
             );
         }
@@ -534,8 +536,10 @@ fn write_csv(
         out.push(',');
         out.push_str(c);
     }
-    for c in model.description().coordinate_names() {
-        out.push_str(&format!(",{c}_dot"));
+    let d = model.description();
+    for i in d.num_dofs()..2 * d.num_dofs() {
+        out.push(',');
+        out.push_str(&d.state_name(i));
     }
     out.push_str(",energy");
     for c in &constraints.constraint_names {
@@ -666,8 +670,10 @@ fn write_events_csv(
     for c in model.description().coordinate_names() {
         out.push_str(&format!(",{c}"));
     }
-    for c in model.description().coordinate_names() {
-        out.push_str(&format!(",{c}_dot"));
+    let d = model.description();
+    for i in d.num_dofs()..2 * d.num_dofs() {
+        out.push(',');
+        out.push_str(&d.state_name(i));
     }
     out.push('\n');
     for e in &solution.events {

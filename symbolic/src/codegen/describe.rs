@@ -36,6 +36,9 @@ pub fn describe(model: &SymbolicModel, eom: &EquationsOfMotion, mathml: bool) ->
         name: text(&model.name),
         summary: text(&model.description),
         coordinates: model.coordinate_names.iter().map(|c| text(c)).collect(),
+        speeds: (model.speeds.iter())
+            .flat_map(|s| s.names.iter().map(|u| text(u)))
+            .collect(),
         parameters: model
             .parameters
             .iter()
@@ -198,6 +201,7 @@ pub fn description_tokens(
     let name = text(&d.name);
     let summary = text(&d.summary);
     let coordinates = texts(&d.coordinates);
+    let speeds = texts(&d.speeds);
     let parameters = d
         .parameters
         .iter()
@@ -314,6 +318,7 @@ pub fn description_tokens(
             name: #name,
             summary: #summary,
             coordinates: #coordinates,
+            speeds: #speeds,
             parameters: #parameters,
             points: #points,
             draw_lines: #draw_lines,

@@ -57,12 +57,6 @@ fn derive(
     file: &crate::model::ModelFile,
 ) -> Result<(SymbolicModel, EquationsOfMotion), GenerateError> {
     let mut model = SymbolicModel::from_file(file).map_err(GenerateError::Diagnostics)?;
-    if let Some(first) = file.speeds.first() {
-        return Err(GenerateError::Diagnostics(vec![
-            crate::model::Diagnostic::new(first.name.location, "a model with generalized speeds is derived and printed (`eomgen equations`, `eomgen check`) but not compiled yet: simulations, analyses and exported code take the state (q, q')")
-                .with_help("to run it, remove `speeds` (the same model in the coordinates' rates)"),
-        ]));
-    }
     crate::mechanics::limit_derivation(&mut model);
     let (eom, _) = crate::mechanics::preferred_equations(&mut model);
     crate::mechanics::finish_derivation(&mut model, file).map_err(GenerateError::Diagnostics)?;
@@ -428,6 +422,7 @@ fn taylor_items(
     // The compiled code's fused orders solve `M q̈ = F` only: a constrained model's series
     // are the run-time compiler's.
     let taylor = match model.constraints.len() {
+        _ if model.speeds.is_some() => Err(eomgen_description::taylor::TaylorUnsupported::Speeds),
         0 => taylor::taylor_program(
             &program::mass_matrix_and_forcing_tape(model, &plans.state),
             n,
@@ -494,7 +489,7 @@ fn function_method(
 
 /// The signature of the method of `function` and the expression or stores that build its
 /// outputs `v` into what the trait returns.
-// Long: one arm per `ModelFunction` (nineteen), each the trait method's signature beside the
+// Long: one arm per `ModelFunction` (twenty-two), each the trait method's signature beside the
 // shape of its result; a table, kept whole so that a signature is read next to its outputs.
 fn signature_and_result(
     function: ModelFunction,
@@ -599,6 +594,17 @@ fn signature_and_result(
         ModelFunction::SupportChanges => (
             quote!(fn support_changes(&self, #q_args, __t: f64, __out: &mut [f64])),
             write_out(v),
+        ),
+        ModelFunction::CoordinateRates => (
+            quote!(fn coordinate_rates(&self, #qd_args, __t: f64) -> #vec_t),
+            vector(v),
+        ),
+        ModelFunction::CoordinateRatesJacobian => (
+            quote!(fn coordinate_rates_jacobian(&self, #qd_args, __t: f64) -> (#mat_t, #mat_t)),
+            {
+                let (d_q, d_u) = (matrix(&v[..n * n]), matrix(&v[n * n..]));
+                quote!((#d_q, #d_u))
+            },
         ),
     }
 }

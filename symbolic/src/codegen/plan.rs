@@ -66,11 +66,15 @@ pub enum ModelFunction {
     /// Each change of support's values, in contact order
     /// (`block` of [`crate::model::elements::support`]).
     SupportChanges,
+    /// With generalized speeds, the kinematic equations `q̇ = W (u − Z)` (n).
+    CoordinateRates,
+    /// With generalized speeds, `∂q̇/∂q` then `∂q̇/∂u` (2 × n × n, row-major each).
+    CoordinateRatesJacobian,
 }
 
 impl ModelFunction {
     /// Every function, in the macro's order.
-    pub const ALL: [ModelFunction; 20] = [
+    pub const ALL: [ModelFunction; 22] = [
         ModelFunction::InitialState,
         ModelFunction::MassMatrix,
         ModelFunction::Forcing,
@@ -91,12 +95,14 @@ impl ModelFunction {
         ModelFunction::ContactJacobian,
         ModelFunction::ContactCoefficients,
         ModelFunction::SupportChanges,
+        ModelFunction::CoordinateRates,
+        ModelFunction::CoordinateRatesJacobian,
     ];
 
     /// The functions of the state that every compilation plans, first and in this order
     /// ([`plan_state`]): all but the exact Jacobians and `mass_matrix` and `forcing` apart
     /// (a backend evaluates both in one).
-    pub const STATE: [ModelFunction; 15] = [
+    pub const STATE: [ModelFunction; 16] = [
         ModelFunction::InitialState,
         ModelFunction::MassMatrixAndForcing,
         ModelFunction::KineticEnergy,
@@ -112,14 +118,16 @@ impl ModelFunction {
         ModelFunction::ContactJacobian,
         ModelFunction::ContactCoefficients,
         ModelFunction::SupportChanges,
+        ModelFunction::CoordinateRates,
     ];
 
     /// The exact Jacobians ([`plan_jacobians`]), which the run-time compiler plans only when
     /// first needed.
-    pub const JACOBIANS: [ModelFunction; 3] = [
+    pub const JACOBIANS: [ModelFunction; 4] = [
         ModelFunction::ForcingJacobianQ,
         ModelFunction::ForcingJacobianQdot,
         ModelFunction::MassMatrixProductJacobian,
+        ModelFunction::CoordinateRatesJacobian,
     ];
 
     /// The method's name in `MechanicalSystem<N>`.
@@ -145,6 +153,8 @@ impl ModelFunction {
             ModelFunction::ContactJacobian => "contact_jacobian",
             ModelFunction::ContactCoefficients => "contact_coefficients",
             ModelFunction::SupportChanges => "support_changes",
+            ModelFunction::CoordinateRates => "coordinate_rates",
+            ModelFunction::CoordinateRatesJacobian => "coordinate_rates_jacobian",
         }
     }
 
@@ -172,6 +182,12 @@ impl ModelFunction {
             ModelFunction::ForcingJacobianQ => jacobians.map(|j| j.forcing_q.clone()),
             ModelFunction::ForcingJacobianQdot => jacobians.map(|j| j.forcing_qdot.clone()),
             ModelFunction::MassMatrixProductJacobian => jacobians.map(|j| j.mass_product_q.clone()),
+            ModelFunction::CoordinateRates => {
+                (model.speeds.as_ref()).map(|s| s.kinematic_equations.clone())
+            }
+            ModelFunction::CoordinateRatesJacobian => {
+                jacobians.and_then(|j| unless_empty(j.coordinate_rates.clone()))
+            }
             ModelFunction::KineticEnergy => Some(vec![model.kinetic]),
             ModelFunction::PotentialEnergy => Some(vec![model.potential]),
             ModelFunction::PointPositions => Some(

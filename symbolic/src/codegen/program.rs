@@ -61,6 +61,8 @@ impl FunctionTape {
 /// | `contact_jacobian` | `G = ∂g/∂q` (m_c × n), then the slips' rows `T` (m_c × n), row-major |
 /// | `contact_coefficients` | `e`, `μ` per contact (2 m_c) |
 /// | `support_changes` | each change of support's values (`block` of [`crate::model::elements::support`]) |
+/// | `coordinate_rates` | with generalized speeds, `q̇ = W (u − Z)` (n), the second inputs read as `u` |
+/// | ([`JacobianProgram`]) `coordinate_rates_jacobian` | `∂q̇/∂q`, then (second buffer) `∂q̇/∂u` (n × n each) |
 #[derive(Debug, Clone, PartialEq)]
 pub struct ModelProgram {
     /// Everything about the model that is not a function of the state ([`super::describe`]).
@@ -95,6 +97,8 @@ pub struct ModelProgram {
     pub contact_coefficients: FunctionTape,
     /// The changes of support's values.
     pub support_changes: FunctionTape,
+    /// The kinematic equations of a model in generalized speeds (empty without speeds).
+    pub coordinate_rates: FunctionTape,
 }
 
 impl ModelProgram {
@@ -149,6 +153,7 @@ impl ModelProgram {
             contact_jacobian: single(F::ContactJacobian),
             contact_coefficients: single(F::ContactCoefficients),
             support_changes: single(F::SupportChanges),
+            coordinate_rates: single(F::CoordinateRates),
         }
     }
 
@@ -171,6 +176,7 @@ impl ModelProgram {
             &mut self.contact_jacobian,
             &mut self.contact_coefficients,
             &mut self.support_changes,
+            &mut self.coordinate_rates,
         ] {
             *tape = FunctionTape::default();
         }
@@ -199,7 +205,7 @@ impl ModelProgram {
 
     /// Every function with its name, in the order of the table above (the Jacobians, planned
     /// apart, not among them).
-    pub fn functions(&self) -> [(&'static str, &FunctionTape); 15] {
+    pub fn functions(&self) -> [(&'static str, &FunctionTape); 16] {
         [
             ("initial_state", &self.initial_state),
             ("mass_matrix_and_forcing", &self.mass_matrix_and_forcing),
@@ -219,6 +225,7 @@ impl ModelProgram {
             ("contact_jacobian", &self.contact_jacobian),
             ("contact_coefficients", &self.contact_coefficients),
             ("support_changes", &self.support_changes),
+            ("coordinate_rates", &self.coordinate_rates),
         ]
     }
 }
@@ -241,11 +248,13 @@ pub struct JacobianProgram {
     pub forcing_jacobian_qdot: FunctionTape,
     /// `∂(M a)/∂q`, `a` read as the acceleration inputs.
     pub mass_matrix_product_jacobian: FunctionTape,
+    /// With generalized speeds, `∂q̇/∂q`, then `∂q̇/∂u` (empty without speeds).
+    pub coordinate_rates_jacobian: FunctionTape,
 }
 
 impl JacobianProgram {
-    /// The three functions with their names.
-    pub fn functions(&self) -> [(&'static str, &FunctionTape); 3] {
+    /// The four functions with their names.
+    pub fn functions(&self) -> [(&'static str, &FunctionTape); 4] {
         [
             ("forcing_jacobian_q", &self.forcing_jacobian_q),
             ("forcing_jacobian_qdot", &self.forcing_jacobian_qdot),
@@ -253,6 +262,7 @@ impl JacobianProgram {
                 "mass_matrix_product_jacobian",
                 &self.mass_matrix_product_jacobian,
             ),
+            ("coordinate_rates_jacobian", &self.coordinate_rates_jacobian),
         ]
     }
 }
@@ -285,6 +295,15 @@ impl Derivation {
             forcing_jacobian_q: column_major(F::ForcingJacobianQ),
             forcing_jacobian_qdot: column_major(F::ForcingJacobianQdot),
             mass_matrix_product_jacobian: column_major(F::MassMatrixProductJacobian),
+            coordinate_rates_jacobian: {
+                let mut tape = tapes.get(F::CoordinateRatesJacobian);
+                let (d_q, d_u) = tape.outputs.split_at((n * n).min(tape.outputs.len()));
+                let mut outputs = column_major_order(d_q, n);
+                outputs.extend(column_major_order(d_u, n));
+                let split = (n * n).min(outputs.len());
+                tape.outputs = outputs;
+                FunctionTape { tape, split }
+            },
         }
     }
 }

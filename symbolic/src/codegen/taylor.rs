@@ -108,6 +108,9 @@ pub fn taylor_program(
 /// # Errors
 /// As [`taylor_program`].
 pub fn model_taylor_plan(program: &ModelProgram) -> Result<TaylorPlan, TaylorUnsupported> {
+    if program.description.has_speeds() {
+        return Err(TaylorUnsupported::Speeds);
+    }
     taylor_program(
         &program.taylor_tape(),
         program.num_dofs(),

@@ -404,6 +404,7 @@ fn unsupported_tokens(
             let name: &str = name;
             quote!(#t::TaylorUnsupported::Stabilization { name: #cow::Borrowed(#name) })
         }
+        TaylorUnsupported::Speeds => quote!(#t::TaylorUnsupported::Speeds),
     }
 }
 

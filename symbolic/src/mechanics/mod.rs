@@ -74,6 +74,9 @@ pub struct Jacobians {
     /// `∂(M a)/∂q`, `n × n` row-major (entry `(i, k)` = `Σⱼ ∂Mᵢⱼ/∂qₖ aⱼ`), where the vector
     /// `a` is represented by the acceleration symbols `q̈ⱼ`.
     pub mass_product_q: Vec<ExprId>,
+    /// With generalized speeds, the Jacobians of the kinematic equations `q̇ = K(q, u, t)`:
+    /// `∂K/∂q`, then `∂K/∂u` (`W`), each `n × n` row-major; empty in the coordinates' rates.
+    pub coordinate_rates: Vec<ExprId>,
 }
 
 impl Jacobians {
@@ -104,10 +107,20 @@ impl Jacobians {
                 mass_product_q.push(arena.diff(row, s[0]));
             }
         }
+        let mut coordinate_rates = Vec::new();
+        let kinematic = model.speeds.as_ref().map(|s| &s.kinematic_equations);
+        for k in [0, 1] {
+            for &rate in kinematic.into_iter().flatten() {
+                for s in &symbols {
+                    coordinate_rates.push(model.arena.diff(rate, s[k]));
+                }
+            }
+        }
         Self {
             forcing_q,
             forcing_qdot,
             mass_product_q,
+            coordinate_rates,
         }
     }
 }

@@ -91,7 +91,7 @@ impl Language {
 ///
 /// # Errors
 /// [`GenerateError::Diagnostics`] for a model that cannot be derived (as `eomgen::model!`
-/// reports it); [`GenerateError::Emit`] for a name of `values` that is not a parameter, or
+/// reports it) or that is in generalized speeds; [`GenerateError::Emit`] for a name of `values` that is not a parameter, or
 /// if a function reads an input its exported signature does not have (a bug of the
 /// exporter, named in the message).
 pub fn export(
@@ -100,6 +100,15 @@ pub fn export(
     language: Language,
     values: &[(String, f64)],
 ) -> Result<String, GenerateError> {
+    if let Some(first) = file.speeds.first() {
+        return Err(GenerateError::Diagnostics(vec![
+            crate::model::Diagnostic::new(
+                first.name.location,
+                "exported code takes the state (q, q'): a model in generalized speeds is not exported yet",
+            )
+            .with_help("to export it, remove `speeds` (the same model in the coordinates' rates)"),
+        ]));
+    }
     let (program, derivation) = ModelProgram::from_file(file)?;
     let jacobians = derivation.jacobians();
     let mut model = Exported::new(&program, &jacobians, source_display);
