@@ -82,6 +82,12 @@ pub trait ModelInfo: OdeSystem {
     fn forcing_jacobians(&self, t: f64, y: &[f64]) -> (DMatrix<f64>, DMatrix<f64>);
     /// The exact `∂(M a)/∂q` (`n × n`) at `(t, q)` for the vector `a` (length `n`).
     fn mass_matrix_product_jacobian(&self, t: f64, y: &[f64], a: &[f64]) -> DMatrix<f64>;
+    /// The coordinates' rates `q̇` (`n`) at `(t, y)`: the kinematic equations of a model in
+    /// generalized speeds ([`ModelDescription::speeds`]), `y`'s second half otherwise.
+    fn coordinate_rates(&self, t: f64, y: &[f64]) -> DVector<f64>;
+    /// The exact `(∂q̇/∂q, ∂q̇/∂u)` of [`Self::coordinate_rates`], each `n × n`, at `(t, y)`
+    /// (`(0, I)` in the coordinates' rates).
+    fn coordinate_rates_jacobian(&self, t: f64, y: &[f64]) -> (DMatrix<f64>, DMatrix<f64>);
     /// Selects the drift control of a constrained model.
     fn set_stabilization(&mut self, stabilization: Stabilization);
     /// The constraint forces `λ` (length `m`; see [`ModelDescription::constraints`] for
@@ -357,6 +363,25 @@ impl<F: FirstOrderForm> ModelInfo for F {
         self.dyn_system()
             .mass_matrix_product_jacobian(&y[..n], t, &a[..n], out.as_mut_slice());
         out
+    }
+    fn coordinate_rates(&self, t: f64, y: &[f64]) -> DVector<f64> {
+        let n = self.num_dofs();
+        let mut out = DVector::zeros(n);
+        self.dyn_system()
+            .coordinate_rates(&y[..n], &y[n..2 * n], t, out.as_mut_slice());
+        out
+    }
+    fn coordinate_rates_jacobian(&self, t: f64, y: &[f64]) -> (DMatrix<f64>, DMatrix<f64>) {
+        let n = self.num_dofs();
+        let (mut d_q, mut d_u) = (DMatrix::zeros(n, n), DMatrix::zeros(n, n));
+        self.dyn_system().coordinate_rates_jacobian(
+            &y[..n],
+            &y[n..2 * n],
+            t,
+            d_q.as_mut_slice(),
+            d_u.as_mut_slice(),
+        );
+        (d_q, d_u)
     }
     fn set_stabilization(&mut self, stabilization: Stabilization) {
         *self.parts_mut().stabilization = stabilization;

@@ -148,6 +148,12 @@ pub(super) fn modal_hint(model: &dyn ModelInfo, e: &eomgen::ModalError) -> Strin
         ModalError::ConstrainedMotion { .. } => {
             "linearise the constrained model at rest (all rates 0)".to_string()
         }
+        ModalError::SpeedsInMotion { .. } => {
+            "linearise the model at rest (all coordinates' rates 0), or remove `speeds` to linearise it in the rates".to_string()
+        }
+        ModalError::SingularKinematics { .. } => format!(
+            "the speeds do not determine the rates at this configuration: choose another operating point ({start}), angles whose singularity lies elsewhere (another `axes:` order), or remove `speeds`"
+        ),
         ModalError::DimensionMismatch { .. } => format!(
             "give one value per coordinate ({})",
             model.description().coordinate_names().join(", ")

@@ -101,7 +101,7 @@ pub struct LinearStability {
     /// `G = (C − Cᵀ)/2` (`r × r`), the gyroscopic part of `C` (rows in JSON).
     #[serde(serialize_with = "crate::serde_matrix::rows")]
     pub gyroscopic_part: DMatrix<f64>,
-    /// With `G ≠ 0`: the frequencies `ω > 0` (rad/s, ascending) of the conservative
+    /// With `G ≠ 0` (above rounding of the scale of `C`, `K` and `M`): the frequencies `ω > 0` (rad/s, ascending) of the conservative
     /// gyroscopic system `M q̈ + G q̇ + K q = 0` (its eigenvalues `±iω` on the imaginary axis;
     /// an unstable one has none). `None` without gyroscopic terms.
     pub gyroscopic_frequencies: Option<Vec<f64>>,
@@ -110,6 +110,11 @@ pub struct LinearStability {
     /// positive value is decided within rounding, and this is its bound.
     pub rounded_real_part: f64,
 }
+
+/// The largest skew part of `C`, relative to the linearisation's scale, that
+/// [`linear_stability`] takes for rounding rather than gyroscopic terms (about 50 units of
+/// rounding: a real gyroscopic coupling is a spin rate times an inertia, orders above).
+const GYROSCOPIC_ROUNDING: f64 = 1e-14;
 
 /// Serialises complex numbers as `[re, im]`.
 fn complex_pairs<S: serde::Serializer>(v: &[Complex<f64>], s: S) -> Result<S::Ok, S::Error> {
@@ -149,7 +154,12 @@ pub fn linear_stability(lin: &Linearization) -> Result<LinearStability, ModalErr
     let damping_part = (c + c.transpose()) * 0.5;
     let gyroscopic_part = (c - c.transpose()) * 0.5;
     let (eigenvalues, rounded_real_part) = rounded_state_eigenvalues(lin)?;
-    let gyroscopic_frequencies = if gyroscopic_part.iter().any(|v| *v != 0.0) {
+    // A skew part at rounding of the linearisation's scale (`|C|`, or `√(|K| |M|)`, a
+    // frequency times a mass) is not gyroscopic: products such as `Yᵀ F_u Y` of a model in
+    // generalized speeds leave 1e-16 of it where the model in rates has none.
+    let scale = c.amax() + (lin.stiffness_matrix.amax() * lin.mass_matrix.amax()).sqrt();
+    let gyroscopic = gyroscopic_part.amax() > GYROSCOPIC_ROUNDING * scale;
+    let gyroscopic_frequencies = if gyroscopic {
         let conservative = Linearization {
             damping_matrix: gyroscopic_part.clone(),
             ..lin.clone()

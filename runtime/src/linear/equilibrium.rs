@@ -28,7 +28,8 @@ pub struct Equilibrium {
 /// Finds an equilibrium of `model` near `guess` by Newton's method with the generated
 /// Jacobians (issue 7, item 1; lecture 25).
 ///
-/// Unconstrained, the unknowns are `q` and the residual is `F(q, 0, t)` with Jacobian `∂F/∂q`.
+/// Unconstrained, the unknowns are `q` and the residual is `F(q, 0, t)` with Jacobian `∂F/∂q`
+/// (in generalized speeds `F(q, Z(q, t), t)`, at rest, with `∂F/∂q + ∂F/∂u ∂Z/∂q`).
 /// With holonomic constraints `Φ(q, t) = 0` (lectures 8–11), the unknowns are `(q, λ)` and the
 /// residual is `[F(q, 0, t) − J(q)ᵀλ; Φ(q, t)]` with Jacobian
 /// `[∂F/∂q − Σᵢ λᵢ ∇²Φᵢ, −Jᵀ; J, 0]`; `λ` starts from the least-squares solution of
@@ -65,11 +66,16 @@ pub fn find_equilibrium(
     let n = model.num_dofs();
     check_point(model, guess)?;
     let m = model.description().holonomic_constraints;
+    // At rest: `q̇ = 0`, which in generalized speeds is `u = Z(q, t)` (NaN where the
+    // kinematic equations are singular, a residual no step accepts).
+    let speeds = model.description().has_speeds();
+    let rest = |q: &[f64]| super::speeds::rest(model, q, t);
     let state = |q: &[f64]| -> Vec<f64> {
-        q.iter()
-            .copied()
-            .chain(std::iter::repeat_n(0.0, n))
-            .collect()
+        let u = match speeds {
+            false => vec![0.0; n],
+            true => rest(q).map_or_else(|_| vec![f64::NAN; n], |r| r.u.as_slice().to_vec()),
+        };
+        q.iter().copied().chain(u).collect()
     };
     // x = [q; λ]; the residual [F − Jᵀλ; Φ].
     let residual_of = |x: &[f64]| -> DVector<f64> {
@@ -88,7 +94,15 @@ pub fn find_equilibrium(
     };
     let jacobian_of = |x: &[f64]| -> DMatrix<f64> {
         let y = state(&x[..n]);
-        let (jq, _, _) = forcing_jacobians(model, t, &y);
+        let (jq, jqd, _) = forcing_jacobians(model, t, &y);
+        if speeds {
+            // d F(q, Z(q))/dq = ∂F/∂q + ∂F/∂u ∂Z/∂q (unconstrained: the rules refuse speeds
+            // beside constraints).
+            return match rest(&x[..n]) {
+                Ok(r) => jq + jqd * r.p,
+                Err(_) => DMatrix::from_element(n, n, f64::NAN),
+            };
+        }
         if m == 0 {
             return jq;
         }

@@ -8,7 +8,8 @@
 //!   from them;
 //! - [`equilibrium`]: equilibria by damped Newton;
 //! - [`modal`]: the exact linearisation `M δq̈ + C δq̇ + K δq = 0` and its state
-//!   matrix, undamped normal modes, the matrix exponential;
+//!   matrix, undamped normal modes, the matrix exponential (a model in generalized speeds
+//!   is linearised in its coordinates by the private `speeds` module);
 //! - [`response`]: the free response of a linearisation computed several independent ways,
 //!   and damping models (modal, Rayleigh) against the exact damped modes;
 //! - [`frequency_response`]: input matrices of load parameters, `H(ω) = (K − ω²M + iωC)⁻¹ B`,
@@ -32,6 +33,7 @@ pub mod frequency_response;
 pub mod modal;
 pub mod monodromy;
 pub mod response;
+mod speeds;
 pub mod state_space;
 pub mod steady;
 mod stops;

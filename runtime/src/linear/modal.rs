@@ -204,6 +204,23 @@ pub enum ModalError {
         /// The largest `|q̇ᵢ|` given.
         speed: f64,
     },
+    /// A model in generalized speeds linearised where it moves (its `q̇ = W (u − Z) ≠ 0`).
+    #[error(
+        "a model in generalized speeds is linearised at rest only (q' = W (u - Z) = 0); the operating point has |q'| = {speed:e}"
+    )]
+    SpeedsInMotion {
+        /// The largest `|q̇ᵢ|` from the kinematic equations.
+        speed: f64,
+    },
+    /// The kinematic equations of a model in generalized speeds are singular there: `W` is
+    /// not invertible or not finite (Euler angles at gimbal lock).
+    #[error(
+        "the kinematic equations q' = W (u - Z) are singular at q = {q:?} (W is not invertible there, as Euler angles are at gimbal lock)"
+    )]
+    SingularKinematics {
+        /// The coordinates.
+        q: Vec<f64>,
+    },
     /// The constraints fix every coordinate: no motion is left to have modes.
     #[error(
         "the {constraints} constraint(s) fix all {coordinates} coordinate(s) at the operating point: no degree of freedom is left, so there are no modes"
@@ -532,7 +549,9 @@ fn asymmetry(k: &DMatrix<f64>) -> f64 {
 /// item 2; lecture 25).
 ///
 /// Unconstrained: `M = M(q*)`, `K = ∂(M q̈*)/∂q − ∂F/∂q`, `C = −∂F/∂q̇` with
-/// `q̈* = M⁻¹F`. With holonomic constraints (at rest only): `q̈*` and `λ*` from
+/// `q̈* = M⁻¹F`. A model in generalized speeds (`qdot` then holds the speeds `u`) is
+/// linearised at rest, in its coordinates, from Kane's equations and the kinematic
+/// equations (`linear/speeds.rs`); an all-zero `qdot` is read as rest there. With holonomic constraints (at rest only): `q̈*` and `λ*` from
 /// `[M Jᵀ; J 0][q̈; λ] = [F; γ]`, the minimal coordinates by coordinate partitioning of `J`
 /// (Gaussian elimination with complete pivoting picks the `rank J` best-conditioned dependent
 /// coordinates), and the projected matrices described at [`Linearization`].
@@ -540,6 +559,8 @@ fn asymmetry(k: &DMatrix<f64>) -> f64 {
 /// # Errors
 /// [`ModalError::NonHolonomic`], [`ModalError::DimensionMismatch`],
 /// [`ModalError::ConstrainedMotion`] (constrained and `q̇ ≠ 0`),
+/// [`ModalError::SpeedsInMotion`] and [`ModalError::SingularKinematics`] (generalized speeds
+/// off rest, or where the kinematic equations are singular),
 /// [`ModalError::OffConstraints`] (`|Φ| > 1e-8`), [`ModalError::SingularMassMatrix`],
 /// [`ModalError::DegenerateCoordinates`] (a mass matrix singular to working precision: the
 /// smallest eigenvalue of `D^{-1/2} M D^{-1/2}`, `D = diag M`, below
@@ -559,6 +580,9 @@ pub fn linearize(
             expected: q.len(),
             found: qdot.len(),
         });
+    }
+    if model.description().has_speeds() {
+        return super::speeds::linearize_at_rest(model, q, qdot, t);
     }
     let n = q.len();
     let m = model.description().holonomic_constraints;

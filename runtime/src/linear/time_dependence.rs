@@ -217,7 +217,9 @@ impl TimeSamples<'_> {
 /// [`ModalError::TimeDependent`] naming the first part found to change, in the order above
 /// (a rheonomic constraint such as a rod spun at a constant rate written with `t`, a
 /// parametrically excited stiffness such as a pendulum on a shaken pivot);
-/// [`ModalError::DimensionMismatch`] and [`ModalError::NonHolonomic`].
+/// [`ModalError::DimensionMismatch`] and [`ModalError::NonHolonomic`];
+/// [`ModalError::SingularKinematics`] for a model in generalized speeds whose kinematic
+/// equations are singular at `q`.
 pub fn time_dependence(
     model: &dyn ModelInfo,
     q: &[f64],
@@ -226,11 +228,15 @@ pub fn time_dependence(
     check_point(model, q)?;
     let n = q.len();
     let m = model.description().holonomic_constraints;
-    let y: Vec<f64> = q
-        .iter()
-        .copied()
-        .chain(std::iter::repeat_n(0.0, n))
-        .collect();
+    // At rest, `q̇ = 0`: in generalized speeds `u = Z(q, t)` at each sample.
+    let at_rest = |t: f64| -> Result<Vec<f64>, ModalError> {
+        let u = match model.description().has_speeds() {
+            true => super::speeds::rest(model, q, t)?.u.as_slice().to_vec(),
+            false => vec![0.0; n],
+        };
+        Ok(q.iter().copied().chain(u).collect())
+    };
+    let y = at_rest(t0)?;
     let times: Vec<f64> = std::iter::once(t0)
         .chain(TIME_OFFSETS.iter().map(|offset| t0 + offset))
         .collect();
@@ -243,6 +249,7 @@ pub fn time_dependence(
     let (mut mass, mut forcing, mut damping, mut stiffness) =
         (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for &t in times {
+        let y = at_rest(t)?;
         let (m_t, f_t) = model.mass_matrix_and_forcing(t, &y);
         let (jq, jqd, _) = forcing_jacobians(model, t, &y);
         mass.push(flat(&m_t));

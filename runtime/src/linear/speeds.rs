@@ -1,0 +1,137 @@
+//! Rest and the linearisation at rest of a model in generalized speeds (`y = (q, u)`), in
+//! its coordinates: the same `M δq̈ + C δq̇ + K δq = 0` as the model written in the rates
+//! gives, so that every analysis of a [`Linearization`] applies unchanged.
+//!
+//! The speeds are `u = Y(q, t) q̇ + Z(q, t)` and the model's kinematic equations
+//! `q̇ = K(q, u, t) = W (u − Z)`, `W = Y⁻¹` (Kane and Levinson, *Dynamics: Theory and
+//! Applications*, 1985, §2.12). Everything below comes from `K` and its exact Jacobians
+//! `K_q = ∂K/∂q`, `W = ∂K/∂u`, with `t` frozen as [`super::modal::linearize`] freezes it:
+//!
+//! - at rest `q̇ = 0`, so `u = Z = −Y K(q, 0)`, and `P = ∂Z/∂q = −Y K_q(q, Z)`;
+//! - near rest `δu = Y δq̇ + P δq` and `δu̇ = Y δq̈ + P δq̇ + E δq`, where `E δq` is
+//!   `∂(Y q̈*)/∂q δq` at the rest's `q̈* = W u̇*`: since `K_q(q, Z + a) − K_q(q, Z) = ∂W/∂q · a`
+//!   (`K` is affine in `u`) and `∂Y = −Y ∂W Y`, `E = −Y (K_q(q, Z + u̇*) − K_q(q, Z))`;
+//! - Kane's `M_u u̇ = F(q, u)` perturbed, `M_u δu̇ = G δq + F_u δu` with
+//!   `G = F_q − ∂(M_u a)/∂q |_(a = u̇*)`, then multiplied by `Yᵀ`:
+//!
+//! ```text
+//! M = Yᵀ M_u Y,   C = Yᵀ (M_u P − F_u Y),   K = Yᵀ (M_u E − G − F_u P)
+//! ```
+//!
+//! `Yᵀ F_u` is the generalized force in the coordinates (Kane's `Fᵣ = Σⱼ Wⱼᵣ Qⱼ`), so `M` and
+//! `K` are symmetric where the model in rates has them symmetric.
+
+use nalgebra::{DMatrix, DVector};
+
+use super::modal::{Linearization, ModalError};
+use crate::model_info::ModelInfo;
+
+/// A model in generalized speeds at rest at `q`: the speeds there and the matrices the
+/// linearisation needs.
+#[derive(Debug, Clone)]
+pub(crate) struct Rest {
+    /// `u = Z(q, t)`, the speeds with `q̇ = 0` (`n`).
+    pub u: DVector<f64>,
+    /// `Y = W⁻¹` (`n × n`).
+    pub y: DMatrix<f64>,
+    /// `P = ∂Z/∂q` (`n × n`).
+    pub p: DMatrix<f64>,
+}
+
+/// The speeds at rest at `(q, t)` of a model in generalized speeds (see the module docs).
+///
+/// # Errors
+/// [`ModalError::SingularKinematics`] where `W` is not finite or not invertible (its
+/// smallest singular value below `1e-12` of its largest).
+pub(crate) fn rest(model: &dyn ModelInfo, q: &[f64], t: f64) -> Result<Rest, ModalError> {
+    let n = q.len();
+    let singular = || ModalError::SingularKinematics { q: q.to_vec() };
+    let mut state: Vec<f64> = q.iter().copied().chain(std::iter::repeat_n(0.0, n)).collect();
+    let k0 = model.coordinate_rates(t, &state);
+    let (_, w) = model.coordinate_rates_jacobian(t, &state);
+    if !(w.iter().all(|v| v.is_finite()) && k0.iter().all(|v| v.is_finite())) {
+        return Err(singular());
+    }
+    let singular_values = w.singular_values();
+    if !(singular_values.min() > 1e-12 * singular_values.max()) {
+        return Err(singular());
+    }
+    let y = w.try_inverse().ok_or_else(singular)?;
+    let u = -(&y * k0);
+    state[n..].copy_from_slice(u.as_slice());
+    let (k_q, _) = model.coordinate_rates_jacobian(t, &state);
+    let p = -(&y * k_q);
+    if !p.iter().all(|v| v.is_finite()) {
+        return Err(singular());
+    }
+    Ok(Rest { u, y, p })
+}
+
+/// Whether `u` is the rest's speeds `rest` to rounding, or all zeros (the callers' way of
+/// asking for rest, `q̇ = 0`, whatever the offsets `Z`).
+fn at_rest(u: &[f64], rest: &DVector<f64>) -> bool {
+    let scale = rest.amax().max(1.0);
+    u.iter().all(|&v| v == 0.0)
+        || u.iter()
+            .zip(rest.iter())
+            .all(|(a, b)| (a - b).abs() <= 1e-12 * scale)
+}
+
+/// The linearisation at rest at `(q, t)` of an unconstrained model in generalized speeds,
+/// in its coordinates (see the module docs); `u` is the state's second half given, which
+/// must be the rest's speeds or all zeros (read as rest).
+///
+/// # Errors
+/// [`ModalError::SpeedsInMotion`] if `u` is not at rest; [`ModalError::SingularKinematics`]
+/// as [`rest`]; [`ModalError::SingularMassMatrix`] if `M_u` is not positive definite;
+/// [`ModalError::NonFinite`] for a matrix that is not finite.
+pub(crate) fn linearize_at_rest(
+    model: &dyn ModelInfo,
+    q: &[f64],
+    u: &[f64],
+    t: f64,
+) -> Result<Linearization, ModalError> {
+    let n = q.len();
+    let rest = rest(model, q, t)?;
+    if !at_rest(u, &rest.u) {
+        let mut moving: Vec<f64> = q.to_vec();
+        moving.extend_from_slice(u);
+        let speed = model.coordinate_rates(t, &moving).amax();
+        return Err(ModalError::SpeedsInMotion { speed });
+    }
+    let state: Vec<f64> = q.iter().chain(rest.u.iter()).copied().collect();
+    let (mass_u, f) = model.mass_matrix_and_forcing(t, &state);
+    let chol = mass_u
+        .clone()
+        .cholesky()
+        .ok_or_else(|| ModalError::SingularMassMatrix { q: q.to_vec() })?;
+    let a = chol.solve(&f);
+    let (f_q, f_u) = model.forcing_jacobians(t, &state);
+    let g = f_q - model.mass_matrix_product_jacobian(t, &state, a.as_slice());
+    let shifted: Vec<f64> = q.iter().chain((&rest.u + &a).iter()).copied().collect();
+    let (k_shifted, _) = model.coordinate_rates_jacobian(t, &shifted);
+    let (k_rest, _) = model.coordinate_rates_jacobian(t, &state);
+    let e = -(&rest.y * (k_shifted - k_rest));
+    let yt = rest.y.transpose();
+    let mass_matrix = &yt * &mass_u * &rest.y;
+    // Symmetric in exact arithmetic; rounding of the products is averaged out.
+    let mass_matrix = (&mass_matrix + mass_matrix.transpose()) * 0.5;
+    let damping_matrix = &yt * (&mass_u * &rest.p - &f_u * &rest.y);
+    let stiffness_matrix = &yt * (&mass_u * e - g - &f_u * &rest.p);
+    let finite = |m: &DMatrix<f64>| m.iter().all(|v| v.is_finite());
+    if !(finite(&mass_matrix) && finite(&damping_matrix) && finite(&stiffness_matrix)) {
+        return Err(ModalError::NonFinite { q: q.to_vec() });
+    }
+    Ok(Linearization {
+        q: q.to_vec(),
+        qdot: vec![0.0; n],
+        t,
+        mass_matrix,
+        stiffness_matrix,
+        damping_matrix,
+        coordinate_basis: DMatrix::identity(n, n),
+        independent_coordinates: (0..n).collect(),
+        lagrange_multipliers: Vec::new(),
+        differenced_entries: 0,
+    })
+}
