@@ -580,6 +580,22 @@ impl CoreModel {
         })
     }
 
+    /// The generalized speeds' names (`speeds:`), empty for a model in the coordinates' rates.
+    #[getter]
+    fn speeds(&self) -> PyResult<Vec<String>> {
+        self.with_instance(|m| m.description().speeds.iter().map(|s| s.to_string()).collect())
+    }
+
+    /// The names of the state's `2n` entries: the coordinates, then their rates (`x_dot`) or
+    /// the generalized speeds.
+    #[getter]
+    fn state_names(&self) -> PyResult<Vec<String>> {
+        self.with_instance(|m| {
+            let d = m.description();
+            (0..2 * d.num_dofs()).map(|i| d.state_name(i)).collect()
+        })
+    }
+
     /// `(name, value)` of every parameter, in the file's order, with this model's values.
     #[getter]
     fn parameters(&self) -> PyResult<Vec<(String, f64)>> {

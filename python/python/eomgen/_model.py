@@ -219,6 +219,18 @@ class Model:
         return list(self._core.coordinates)
 
     @property
+    def speeds(self) -> List[str]:
+        """The generalized speeds' names ``u`` (the file's ``speeds:``; ``n`` names), empty for a
+        model in the coordinates' rates. With speeds the state is ``y = [q; u]``."""
+        return list(self._core.speeds)
+
+    @property
+    def state_names(self) -> List[str]:
+        """The names of the state's ``2n`` entries: the coordinates, then their rates
+        (``x_dot``) or, with generalized speeds, the speeds."""
+        return list(self._core.state_names)
+
+    @property
     def parameters(self) -> Dict[str, float]:
         """Every parameter's value, by name, in the file's order (this model's values)."""
         return dict(self._core.parameters)
@@ -245,9 +257,10 @@ class Model:
         return Model(self._core.with_parameters([(str(k), float(v)) for k, v in merged.items()]))
 
     def initial_state(self, initial: Optional[Union[Mapping[str, float], ArrayLike]] = None) -> np.ndarray:
-        """The state ``y0 = [q; q̇]`` (``2n``) a simulation starts from: the file's
-        ``initial:``, with ``initial`` applied — a dict of coordinates and rates
-        (``{"theta1": 0.5, "theta1_dot": 0.0}``) or a whole state of ``2n`` entries.
+        """The state ``y0 = [q; q̇]`` (``2n``; ``[q; u]`` with generalized speeds) a simulation
+        starts from: the file's ``initial:``, with ``initial`` applied — a dict of coordinates
+        and rates (``{"theta1": 0.5, "theta1_dot": 0.0}``; the speeds by name with speeds) or a
+        whole state of ``2n`` entries.
 
         Raises:
             ValueError: a name that is neither a coordinate nor a rate ``<coordinate>_dot``,
@@ -258,13 +271,14 @@ class Model:
             return y0
         if isinstance(initial, Mapping):
             names = self.coordinates
-            index = {c: i for i, c in enumerate(names)}
-            index.update({c + "_dot": len(names) + i for i, c in enumerate(names)})
+            states = self.state_names
+            index = {c: i for i, c in enumerate(states)}
             for key, value in initial.items():
                 if key not in index:
+                    second = ", ".join(states[len(names):]) if self.speeds else "<coordinate>_dot"
                     raise ValueError(
                         f"`{key}` is not a coordinate or rate of `{self.name}` "
-                        f"(coordinates: {', '.join(names)}; rates: <coordinate>_dot)"
+                        f"(coordinates: {', '.join(names)}; {'speeds' if self.speeds else 'rates'}: {second})"
                     )
                 y0[index[key]] = _finite(value, f"initial `{key}`")
             return y0
@@ -1151,7 +1165,7 @@ class Solution:
         table = ""
         if k:
             names = list(h.get("coordinates", [f"q{i}" for i in range(self._num_dofs)]))
-            table = _html_table(["coordinate", f"q(t = {self.t[-1]:.6g})", "q̇"],
+            table = _html_table(["coordinate", f"q(t = {self.t[-1]:.6g})", "u" if h.get("speeds") else "q̇"],
                                 ((c, f"{self.q[-1, i]:.10g}", f"{self.qdot[-1, i]:.10g}")
                                  for i, c in enumerate(names)))
         return "<br>".join(lines) + table
@@ -1183,7 +1197,8 @@ class Solution:
             axes[row, 0].set_ylabel(c)
             if rates:
                 axes[row, 1].plot(self.t, self.qdot[:, i])
-                axes[row, 1].set_ylabel(f"{c}_dot")
+                speeds = self.summary_header.get("speeds")
+                axes[row, 1].set_ylabel(speeds[i] if speeds else f"{c}_dot")
         for col in range(columns):
             axes[-1, col].set_xlabel("t (s)")
         fig.suptitle(str(self.summary_header["model"]))

@@ -516,6 +516,10 @@ pub struct SimulationSummary {
     pub model: String,
     /// The generalized coordinates' names, in the state's order.
     pub coordinates: Vec<String>,
+    /// With generalized speeds, their names (`n`): every sample's `qdot` then holds the
+    /// speeds `u` rather than the rates. Left out for a model in the coordinates' rates.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub speeds: Vec<String>,
     /// The parameters' values, by name (units of the model file).
     pub parameters: BTreeMap<String, f64>,
     /// The integrator's name ([`Simulation::integrator`], `"dp54"`).
@@ -700,6 +704,7 @@ impl Simulation {
                 .iter()
                 .map(|s| s.to_string())
                 .collect(),
+            speeds: description.speeds.iter().map(|s| s.to_string()).collect(),
             parameters: description
                 .parameter_names()
                 .iter()

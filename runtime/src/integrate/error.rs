@@ -103,7 +103,7 @@ pub enum IntegrationError {
     /// ([`OdeSystem::second_order_dim`](crate::OdeSystem::second_order_dim)), and this one
     /// does not declare that structure (or declares one that does not match its dimension).
     #[error(
-        "`{method}` needs a second-order system y = [q; q̇] (OdeSystem::second_order_dim), and this one is not"
+        "`{method}` needs a second-order system y = [q; q̇] (OdeSystem::second_order_dim), and this one is not (a model in generalized speeds has y = [q; u]: take an explicit or implicit Runge–Kutta method)"
     )]
     NotSecondOrder {
         /// The method's [`name`](super::Integrator::name).

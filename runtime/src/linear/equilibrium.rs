@@ -71,11 +71,8 @@ pub fn find_equilibrium(
     let speeds = model.description().has_speeds();
     let rest = |q: &[f64]| super::speeds::rest(model, q, t);
     let state = |q: &[f64]| -> Vec<f64> {
-        let u = match speeds {
-            false => vec![0.0; n],
-            true => rest(q).map_or_else(|_| vec![f64::NAN; n], |r| r.u.as_slice().to_vec()),
-        };
-        q.iter().copied().chain(u).collect()
+        super::speeds::rest_state(model, q, t)
+            .unwrap_or_else(|_| q.iter().copied().chain(vec![f64::NAN; n]).collect())
     };
     // x = [q; λ]; the residual [F − Jᵀλ; Φ].
     let residual_of = |x: &[f64]| -> DVector<f64> {

@@ -390,7 +390,7 @@ fn linearize_with_inputs_inner(
     // Coefficients that change with t (a shaken pivot) have no frequency response; a load
     // left in F that is not an input is the same at every frequency and stays out of H.
     time_dependence(&*model, &equilibrium.q, 0.0)?;
-    let y: Vec<f64> = equilibrium.q.iter().chain(&zeros).copied().collect();
+    let y = super::speeds::rest_state(&*model, &equilibrium.q, 0.0)?;
     let mut input_matrix = DMatrix::zeros(n, inputs.len());
     for (j, input) in inputs.iter().enumerate() {
         if !model.description().parameter_names().contains(input)
@@ -430,7 +430,8 @@ fn linearize_with_inputs_inner(
                 input: input.to_string(),
             });
         }
-        input_matrix.set_column(j, &d1);
+        let column = super::speeds::coordinate_force(&*model, &equilibrium.q, 0.0, d1)?;
+        input_matrix.set_column(j, &column);
     }
     Ok(ForcedLinearization {
         equilibrium,
@@ -517,13 +518,8 @@ fn input_rate_matrix(
         _ => 1.0,
     };
     let n = forced.input_matrix.nrows();
-    let y: Vec<f64> = forced
-        .equilibrium
-        .q
-        .iter()
-        .copied()
-        .chain(std::iter::repeat_n(0.0, n))
-        .collect();
+    let q = &forced.equilibrium.q;
+    let y = super::speeds::rest_state(&*model, q, 0.0)?;
     for input in &forced.inputs {
         if names.iter().any(|p| p == input) {
             model.set_parameter(input, 0.0)?;
@@ -580,7 +576,7 @@ fn input_rate_matrix(
                 deviation,
             });
         }
-        rates.set_column(j, &b1);
+        rates.set_column(j, &super::speeds::coordinate_force(&*model, q, 0.0, b1)?);
     }
     Ok(rates)
 }

@@ -33,7 +33,7 @@ pub mod frequency_response;
 pub mod modal;
 pub mod monodromy;
 pub mod response;
-mod speeds;
+pub(crate) mod speeds;
 pub mod state_space;
 pub mod steady;
 mod stops;

@@ -601,11 +601,10 @@ pub fn check_periodic_equilibrium(
             found: q.len(),
         });
     }
-    let y: Vec<f64> = q
-        .iter()
-        .copied()
-        .chain(std::iter::repeat_n(0.0, n))
-        .collect();
+    // At rest (in generalized speeds `u = Z(q, t₀)`; NaN, which no equilibrium passes, where
+    // their kinematic equations are singular).
+    let y = super::speeds::rest_state(model, q, t0)
+        .unwrap_or_else(|_| q.iter().copied().chain(vec![f64::NAN; n]).collect());
     let times =
         std::iter::once(t0).chain((0..64).map(|k| t0 + (f64::from(k) + 0.382) * period / 64.0));
     let (mut worst_t, mut worst, mut scale) = (t0, 0.0f64, 0.0f64);

@@ -67,6 +67,36 @@ pub(crate) fn rest(model: &dyn ModelInfo, q: &[f64], t: f64) -> Result<Rest, Mod
     Ok(Rest { u, y, p })
 }
 
+/// The state at rest at `(q, t)`: `(q, 0)`, or in generalized speeds `(q, Z(q, t))`.
+///
+/// # Errors
+/// As [`rest`], for a model in generalized speeds.
+pub(crate) fn rest_state(model: &dyn ModelInfo, q: &[f64], t: f64) -> Result<Vec<f64>, ModalError> {
+    let u = match model.description().has_speeds() {
+        true => rest(model, q, t)?.u.as_slice().to_vec(),
+        false => vec![0.0; q.len()],
+    };
+    Ok(q.iter().copied().chain(u).collect())
+}
+
+/// A generalized force of Kane's equations at rest at `(q, t)` (a column of `∂F/∂p`) in the
+/// model's coordinates: `Yᵀ f` in generalized speeds (the linearisation's `K` and `C` are
+/// multiplied by `Yᵀ` the same way), `f` itself otherwise.
+///
+/// # Errors
+/// As [`rest`], for a model in generalized speeds.
+pub(crate) fn coordinate_force(
+    model: &dyn ModelInfo,
+    q: &[f64],
+    t: f64,
+    f: DVector<f64>,
+) -> Result<DVector<f64>, ModalError> {
+    match model.description().has_speeds() {
+        true => Ok(rest(model, q, t)?.y.transpose() * f),
+        false => Ok(f),
+    }
+}
+
 /// Whether `u` is the rest's speeds `rest` to rounding, or all zeros (the callers' way of
 /// asking for rest, `q̇ = 0`, whatever the offsets `Z`).
 fn at_rest(u: &[f64], rest: &DVector<f64>) -> bool {

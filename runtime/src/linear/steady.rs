@@ -133,6 +133,12 @@ pub enum SteadyMotionError {
         /// The shift of the coordinate where it was found.
         shift: f64,
     },
+    /// The model is in generalized speeds: steady motions hold rates of the coordinates,
+    /// which its state does not have.
+    #[error(
+        "steady motions hold coordinates' rates, and a model in generalized speeds has its speeds in the state instead: find its steady motions in the coordinates' rates (remove `speeds`)"
+    )]
+    InSpeeds,
     /// A steady turn's equations are not symmetric under turning: the accelerations at the
     /// state turned about the plane's normal are not the turned accelerations, so the turn
     /// changes the equations and is no steady motion.
@@ -314,13 +320,17 @@ pub fn linearize_steady_motion(
 /// ([`crate::linear::turning`]). See the module documentation for the method.
 ///
 /// # Errors
-/// As [`linearize_steady_motion`].
+/// As [`linearize_steady_motion`]; [`SteadyMotionError::InSpeeds`] for a model in generalized
+/// speeds.
 pub fn linearize_steady_motion_with(
     model: &mut dyn ModelInfo,
     t: f64,
     y: &[f64],
     spec: &SteadyMotionSpec,
 ) -> Result<SteadyLinearization, SteadyMotionError> {
+    if model.description().has_speeds() {
+        return Err(SteadyMotionError::InSpeeds);
+    }
     let ignorable = spec.ignorable.as_slice();
     spec.check(y.len() / 2)?;
     let d = model.description().clone();

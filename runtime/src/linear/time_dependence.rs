@@ -229,13 +229,7 @@ pub fn time_dependence(
     let n = q.len();
     let m = model.description().holonomic_constraints;
     // At rest, `q̇ = 0`: in generalized speeds `u = Z(q, t)` at each sample.
-    let at_rest = |t: f64| -> Result<Vec<f64>, ModalError> {
-        let u = match model.description().has_speeds() {
-            true => super::speeds::rest(model, q, t)?.u.as_slice().to_vec(),
-            false => vec![0.0; n],
-        };
-        Ok(q.iter().copied().chain(u).collect())
-    };
+    let at_rest = |t: f64| super::speeds::rest_state(model, q, t);
     let y = at_rest(t0)?;
     let times: Vec<f64> = std::iter::once(t0)
         .chain(TIME_OFFSETS.iter().map(|offset| t0 + offset))

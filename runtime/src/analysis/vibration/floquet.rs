@@ -269,13 +269,8 @@ fn analyse(
     let equilibrium =
         find_equilibrium(model, guess, 0.0).map_err(FloquetStudyError::Equilibrium)?;
     let residual = check_periodic_equilibrium(model, &equilibrium.q, 0.0, period)?;
-    let n = model.num_dofs();
-    let y0: Vec<f64> = equilibrium
-        .q
-        .iter()
-        .copied()
-        .chain(std::iter::repeat_n(0.0, n))
-        .collect();
+    let y0 = crate::linear::speeds::rest_state(model, &equilibrium.q, 0.0)
+        .map_err(FloquetStudyError::Equilibrium)?;
     let floquet = floquet_analysis(model.as_ode_mut(), &y0, 0.0, period, &options.floquet)?;
     Ok(FloquetPoint {
         name,

@@ -104,13 +104,17 @@ pub fn find_steady_motion(
 /// the coordinates, as Euler angles at `θ = 0`); [`SteadyMotionError::Rhs`] when they cannot
 /// be evaluated at the guess; [`SteadyMotionError::HeldRateNotIgnorable`] when the motion
 /// moves a coordinate not declared ignorable; [`SteadyMotionError::NotCyclic`] when a moving
-/// coordinate changes the equations, [`SteadyMotionError::NotSymmetric`] when the turn does.
+/// coordinate changes the equations, [`SteadyMotionError::NotSymmetric`] when the turn does;
+/// [`SteadyMotionError::InSpeeds`] for a model in generalized speeds.
 pub fn find_steady_motion_with(
     model: &mut dyn ModelInfo,
     t: f64,
     guess: &[f64],
     spec: &SteadyMotionSpec,
 ) -> Result<SteadyMotion, SteadyMotionError> {
+    if model.description().has_speeds() {
+        return Err(SteadyMotionError::InSpeeds);
+    }
     let n = guess.len();
     spec.check(n)?;
     let names = owned_state_names(model);
