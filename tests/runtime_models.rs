@@ -30,7 +30,12 @@ fn assert_same(what: &str, a: &[f64], b: &[f64]) {
 }
 
 /// Compares every numeric function of `compiled` and `runtime` at `states` random states.
-fn compare(name: &str, compiled: &mut dyn ModelInfo, runtime: &mut dyn ModelInfo, states: usize) {
+pub(crate) fn compare(
+    name: &str,
+    compiled: &mut dyn ModelInfo,
+    runtime: &mut dyn ModelInfo,
+    states: usize,
+) {
     let n = compiled.num_dofs();
     assert_eq!(runtime.num_dofs(), n, "{name}: dofs");
     // The whole description: names, parameter defaults, points, drawing, constraints,
@@ -154,7 +159,7 @@ fn bundled_file(entry: &eomgen::models::ModelEntry) -> String {
     format!("{}/{}", env!("CARGO_MANIFEST_DIR"), entry.file)
 }
 
-fn runtime_model(path: &str, backend: Option<Backend>) -> Box<dyn ModelInfo> {
+pub(crate) fn runtime_model(path: &str, backend: Option<Backend>) -> Box<dyn ModelInfo> {
     // With the MathML, which a compiled model always carries, so that the descriptions
     // compare whole.
     let options = LoadOptions {

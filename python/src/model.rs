@@ -583,7 +583,13 @@ impl CoreModel {
     /// The generalized speeds' names (`speeds:`), empty for a model in the coordinates' rates.
     #[getter]
     fn speeds(&self) -> PyResult<Vec<String>> {
-        self.with_instance(|m| m.description().speeds.iter().map(|s| s.to_string()).collect())
+        self.with_instance(|m| {
+            m.description()
+                .speeds
+                .iter()
+                .map(|s| s.to_string())
+                .collect()
+        })
     }
 
     /// The names of the state's `2n` entries: the coordinates, then their rates (`x_dot`) or

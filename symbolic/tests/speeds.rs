@@ -249,7 +249,8 @@ fn strip_section(source: &str, key: &str) -> String {
 
 /// The messages of a file whose speeds are wrong, each at its place: nonlinear, dependent,
 /// too few, beside constraints, with both initial rates and speeds; and a model with speeds
-/// is not compiled (yet), said so rather than run in the wrong state.
+/// is not exported (its exported functions take `(q, q̇)`), said so rather than exported in
+/// the wrong state.
 #[test]
 fn mistaken_speeds_are_located() {
     let lowering_error = |source: &str| -> String {
@@ -346,12 +347,18 @@ fn mistaken_speeds_are_located() {
         "{e}"
     );
     let file = eomgen_symbolic::model::load("m.yaml", FREE_BODY).expect("loads");
-    let refused = eomgen_symbolic::codegen::generate(&file, &Default::default());
-    let Err(eomgen_symbolic::codegen::GenerateError::Diagnostics(d)) = refused else {
-        panic!("a model with speeds compiled")
+    let exported = eomgen_symbolic::codegen::export::export(
+        &file,
+        "m.yaml",
+        eomgen_symbolic::codegen::export::Language::C,
+        &[],
+    );
+    let Err(eomgen_symbolic::codegen::GenerateError::Diagnostics(d)) = exported else {
+        panic!("a model with speeds exported")
     };
     assert!(
-        d[0].message.contains("not compiled yet"),
+        d[0].message
+            .contains("a model in generalized speeds is not exported yet"),
         "{}",
         d[0].message
     );

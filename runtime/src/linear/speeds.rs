@@ -46,7 +46,11 @@ pub(crate) struct Rest {
 pub(crate) fn rest(model: &dyn ModelInfo, q: &[f64], t: f64) -> Result<Rest, ModalError> {
     let n = q.len();
     let singular = || ModalError::SingularKinematics { q: q.to_vec() };
-    let mut state: Vec<f64> = q.iter().copied().chain(std::iter::repeat_n(0.0, n)).collect();
+    let mut state: Vec<f64> = q
+        .iter()
+        .copied()
+        .chain(std::iter::repeat_n(0.0, n))
+        .collect();
     let k0 = model.coordinate_rates(t, &state);
     let (_, w) = model.coordinate_rates_jacobian(t, &state);
     if !(w.iter().all(|v| v.is_finite()) && k0.iter().all(|v| v.is_finite())) {
