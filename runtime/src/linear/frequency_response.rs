@@ -390,7 +390,7 @@ fn linearize_with_inputs_inner(
     // Coefficients that change with t (a shaken pivot) have no frequency response; a load
     // left in F that is not an input is the same at every frequency and stays out of H.
     time_dependence(&*model, &equilibrium.q, 0.0)?;
-    let y = super::speeds::rest_state(&*model, &equilibrium.q, 0.0)?;
+    let y = super::speeds::rest_state(&*model, &equilibrium.q, 0.0).map_err(ModalError::from)?;
     let mut input_matrix = DMatrix::zeros(n, inputs.len());
     for (j, input) in inputs.iter().enumerate() {
         if !model.description().parameter_names().contains(input)
@@ -430,7 +430,8 @@ fn linearize_with_inputs_inner(
                 input: input.to_string(),
             });
         }
-        let column = super::speeds::coordinate_force(&*model, &equilibrium.q, 0.0, d1)?;
+        let column = super::speeds::coordinate_force(&*model, &equilibrium.q, 0.0, d1)
+            .map_err(ModalError::from)?;
         input_matrix.set_column(j, &column);
     }
     Ok(ForcedLinearization {
@@ -519,7 +520,7 @@ fn input_rate_matrix(
     };
     let n = forced.input_matrix.nrows();
     let q = &forced.equilibrium.q;
-    let y = super::speeds::rest_state(&*model, q, 0.0)?;
+    let y = super::speeds::rest_state(&*model, q, 0.0).map_err(ModalError::from)?;
     for input in &forced.inputs {
         if names.iter().any(|p| p == input) {
             model.set_parameter(input, 0.0)?;
@@ -576,7 +577,9 @@ fn input_rate_matrix(
                 deviation,
             });
         }
-        rates.set_column(j, &super::speeds::coordinate_force(&*model, q, 0.0, b1)?);
+        let column =
+            super::speeds::coordinate_force(&*model, q, 0.0, b1).map_err(ModalError::from)?;
+        rates.set_column(j, &column);
     }
     Ok(rates)
 }

@@ -241,6 +241,18 @@ pub enum ModalError {
     },
 }
 
+impl From<super::speeds::KinematicsError> for ModalError {
+    fn from(e: super::speeds::KinematicsError) -> Self {
+        use super::speeds::KinematicsFailure as F;
+        match e.kind {
+            F::Singular => ModalError::SingularKinematics { q: e.q },
+            F::Moving(speed) => ModalError::SpeedsInMotion { speed },
+            F::SingularMassMatrix => ModalError::SingularMassMatrix { q: e.q },
+            F::NonFinite => ModalError::NonFinite { q: e.q },
+        }
+    }
+}
+
 pub use super::stops::{NewtonStop, TimeDependentForcing, TimeDependentPart};
 pub use super::time_dependence::time_dependence;
 
@@ -582,7 +594,20 @@ pub fn linearize(
         });
     }
     if model.description().has_speeds() {
-        return super::speeds::linearize_at_rest(model, q, qdot, t);
+        let rest = super::speeds::linearize_at_rest(model, q, qdot, t)?;
+        let n = q.len();
+        return Ok(Linearization {
+            q: q.to_vec(),
+            qdot: vec![0.0; n],
+            t,
+            mass_matrix: rest.mass,
+            stiffness_matrix: rest.stiffness,
+            damping_matrix: rest.damping,
+            coordinate_basis: DMatrix::identity(n, n),
+            independent_coordinates: (0..n).collect(),
+            lagrange_multipliers: Vec::new(),
+            differenced_entries: 0,
+        });
     }
     let n = q.len();
     let m = model.description().holonomic_constraints;

@@ -1,6 +1,6 @@
 //! Rest and the linearisation at rest of a model in generalized speeds (`y = (q, u)`), in
 //! its coordinates: the same `M δq̈ + C δq̇ + K δq = 0` as the model written in the rates
-//! gives, so that every analysis of a [`Linearization`] applies unchanged.
+//! gives, so that every analysis of a [`super::modal::Linearization`] applies unchanged.
 //!
 //! The speeds are `u = Y(q, t) q̇ + Z(q, t)` and the model's kinematic equations
 //! `q̇ = K(q, u, t) = W (u − Z)`, `W = Y⁻¹` (Kane and Levinson, *Dynamics: Theory and
@@ -23,8 +23,41 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use super::modal::{Linearization, ModalError};
 use crate::model_info::ModelInfo;
+
+/// Why a model in generalized speeds has no rest or linearisation at `q`, with `q`
+/// ([`super::modal::ModalError`] has a variant for each: this module is below it).
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct KinematicsError {
+    /// What failed.
+    pub kind: KinematicsFailure,
+    /// The coordinates.
+    pub q: Vec<f64>,
+}
+
+/// What [`KinematicsError`] says failed.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum KinematicsFailure {
+    /// `W` is not finite or not invertible.
+    Singular,
+    /// The state given is not at rest: its largest `|q̇ᵢ|`.
+    Moving(f64),
+    /// `M_u` is not positive definite.
+    SingularMassMatrix,
+    /// A matrix of the linearisation is not finite.
+    NonFinite,
+}
+
+/// The matrices of the linearisation at rest, in the coordinates (`n × n` each).
+#[derive(Debug, Clone)]
+pub(crate) struct RestMatrices {
+    /// `M = Yᵀ M_u Y`.
+    pub mass: DMatrix<f64>,
+    /// `C = Yᵀ (M_u P − F_u Y)`.
+    pub damping: DMatrix<f64>,
+    /// `K = Yᵀ (M_u E − G − F_u P)`.
+    pub stiffness: DMatrix<f64>,
+}
 
 /// A model in generalized speeds at rest at `q`: the speeds there and the matrices the
 /// linearisation needs.
@@ -41,11 +74,11 @@ pub(crate) struct Rest {
 /// The speeds at rest at `(q, t)` of a model in generalized speeds (see the module docs).
 ///
 /// # Errors
-/// [`ModalError::SingularKinematics`] where `W` is not finite or not invertible (its
-/// smallest singular value below `1e-12` of its largest).
-pub(crate) fn rest(model: &dyn ModelInfo, q: &[f64], t: f64) -> Result<Rest, ModalError> {
+/// [`KinematicsFailure::Singular`] where `W` is not finite or not invertible (its smallest
+/// singular value below `1e-12` of its largest).
+pub(crate) fn rest(model: &dyn ModelInfo, q: &[f64], t: f64) -> Result<Rest, KinematicsError> {
     let n = q.len();
-    let singular = || ModalError::SingularKinematics { q: q.to_vec() };
+    let singular = || failure(q, KinematicsFailure::Singular);
     let mut state: Vec<f64> = q
         .iter()
         .copied()
@@ -57,7 +90,8 @@ pub(crate) fn rest(model: &dyn ModelInfo, q: &[f64], t: f64) -> Result<Rest, Mod
         return Err(singular());
     }
     let singular_values = w.singular_values();
-    if !(singular_values.min() > 1e-12 * singular_values.max()) {
+    // Finite (checked above), so no NaN among them.
+    if singular_values.min() <= 1e-12 * singular_values.max() {
         return Err(singular());
     }
     let y = w.try_inverse().ok_or_else(singular)?;
@@ -75,7 +109,11 @@ pub(crate) fn rest(model: &dyn ModelInfo, q: &[f64], t: f64) -> Result<Rest, Mod
 ///
 /// # Errors
 /// As [`rest`], for a model in generalized speeds.
-pub(crate) fn rest_state(model: &dyn ModelInfo, q: &[f64], t: f64) -> Result<Vec<f64>, ModalError> {
+pub(crate) fn rest_state(
+    model: &dyn ModelInfo,
+    q: &[f64],
+    t: f64,
+) -> Result<Vec<f64>, KinematicsError> {
     let u = match model.description().has_speeds() {
         true => rest(model, q, t)?.u.as_slice().to_vec(),
         false => vec![0.0; q.len()],
@@ -94,7 +132,7 @@ pub(crate) fn coordinate_force(
     q: &[f64],
     t: f64,
     f: DVector<f64>,
-) -> Result<DVector<f64>, ModalError> {
+) -> Result<DVector<f64>, KinematicsError> {
     match model.description().has_speeds() {
         true => Ok(rest(model, q, t)?.y.transpose() * f),
         false => Ok(f),
@@ -116,29 +154,28 @@ fn at_rest(u: &[f64], rest: &DVector<f64>) -> bool {
 /// must be the rest's speeds or all zeros (read as rest).
 ///
 /// # Errors
-/// [`ModalError::SpeedsInMotion`] if `u` is not at rest; [`ModalError::SingularKinematics`]
-/// as [`rest`]; [`ModalError::SingularMassMatrix`] if `M_u` is not positive definite;
-/// [`ModalError::NonFinite`] for a matrix that is not finite.
+/// [`KinematicsFailure::Moving`] if `u` is not at rest, [`KinematicsFailure::Singular`] as
+/// [`rest`], [`KinematicsFailure::SingularMassMatrix`] if `M_u` is not positive definite,
+/// [`KinematicsFailure::NonFinite`] for a matrix that is not finite.
 pub(crate) fn linearize_at_rest(
     model: &dyn ModelInfo,
     q: &[f64],
     u: &[f64],
     t: f64,
-) -> Result<Linearization, ModalError> {
-    let n = q.len();
+) -> Result<RestMatrices, KinematicsError> {
     let rest = rest(model, q, t)?;
     if !at_rest(u, &rest.u) {
         let mut moving: Vec<f64> = q.to_vec();
         moving.extend_from_slice(u);
         let speed = model.coordinate_rates(t, &moving).amax();
-        return Err(ModalError::SpeedsInMotion { speed });
+        return Err(failure(q, KinematicsFailure::Moving(speed)));
     }
     let state: Vec<f64> = q.iter().chain(rest.u.iter()).copied().collect();
     let (mass_u, f) = model.mass_matrix_and_forcing(t, &state);
     let chol = mass_u
         .clone()
         .cholesky()
-        .ok_or_else(|| ModalError::SingularMassMatrix { q: q.to_vec() })?;
+        .ok_or_else(|| failure(q, KinematicsFailure::SingularMassMatrix))?;
     let a = chol.solve(&f);
     let (f_q, f_u) = model.forcing_jacobians(t, &state);
     let g = f_q - model.mass_matrix_product_jacobian(t, &state, a.as_slice());
@@ -154,18 +191,18 @@ pub(crate) fn linearize_at_rest(
     let stiffness_matrix = &yt * (&mass_u * e - g - &f_u * &rest.p);
     let finite = |m: &DMatrix<f64>| m.iter().all(|v| v.is_finite());
     if !(finite(&mass_matrix) && finite(&damping_matrix) && finite(&stiffness_matrix)) {
-        return Err(ModalError::NonFinite { q: q.to_vec() });
+        return Err(failure(q, KinematicsFailure::NonFinite));
     }
-    Ok(Linearization {
-        q: q.to_vec(),
-        qdot: vec![0.0; n],
-        t,
-        mass_matrix,
-        stiffness_matrix,
-        damping_matrix,
-        coordinate_basis: DMatrix::identity(n, n),
-        independent_coordinates: (0..n).collect(),
-        lagrange_multipliers: Vec::new(),
-        differenced_entries: 0,
+    Ok(RestMatrices {
+        mass: mass_matrix,
+        damping: damping_matrix,
+        stiffness: stiffness_matrix,
     })
+}
+
+fn failure(q: &[f64], kind: KinematicsFailure) -> KinematicsError {
+    KinematicsError {
+        kind,
+        q: q.to_vec(),
+    }
 }

@@ -270,7 +270,7 @@ fn analyse(
         find_equilibrium(model, guess, 0.0).map_err(FloquetStudyError::Equilibrium)?;
     let residual = check_periodic_equilibrium(model, &equilibrium.q, 0.0, period)?;
     let y0 = crate::linear::speeds::rest_state(model, &equilibrium.q, 0.0)
-        .map_err(FloquetStudyError::Equilibrium)?;
+        .map_err(|e| FloquetStudyError::Equilibrium(e.into()))?;
     let floquet = floquet_analysis(model.as_ode_mut(), &y0, 0.0, period, &options.floquet)?;
     Ok(FloquetPoint {
         name,
