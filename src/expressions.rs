@@ -338,14 +338,46 @@ pub fn set_initial_values(
     y: &mut [f64],
     assignments: &[impl AsRef<str>],
 ) -> Result<(), ExpressionError> {
+    let description = model.description();
+    let names: Vec<String> = (0..2 * model.num_dofs())
+        .map(|i| description.state_name(i))
+        .collect();
+    set_named_values(model, y, assignments, &names)
+}
+
+/// Applies `NAME=VALUE` values, as [`set_initial_values`], to `y = [δq; δq̇]` of a
+/// linearisation of `model`, which is in the coordinates and their rates (`x_dot`) whether or
+/// not the model is in generalized speeds.
+///
+/// # Errors
+/// As [`set_initial_values`].
+pub fn set_linearized_values(
+    model: &dyn ModelInfo,
+    y: &mut [f64],
+    assignments: &[impl AsRef<str>],
+) -> Result<(), ExpressionError> {
+    let coordinates = model.description().coordinate_names();
+    let names: Vec<String> = (coordinates.iter().map(|c| c.to_string()))
+        .chain(coordinates.iter().map(|c| format!("{c}_dot")))
+        .collect();
+    set_named_values(model, y, assignments, &names)
+}
+
+/// Applies `NAME=VALUE` values to the entries of `y` named `names` (`2n`: coordinates, then
+/// the second half).
+fn set_named_values(
+    model: &dyn ModelInfo,
+    y: &mut [f64],
+    assignments: &[impl AsRef<str>],
+    names: &[String],
+) -> Result<(), ExpressionError> {
     let n = model.num_dofs();
     let coordinates = model.description().coordinate_names();
     for s in assignments.iter().flat_map(|s| split_list(s.as_ref())) {
         let (name, text) = split_assignment(s, "--init")?;
         let value = evaluate(text, &format!("--init {name}"), &parameter_lookup(model))?;
-        let description = model.description();
-        let index = description.state_index(name).ok_or_else(|| {
-            let rates: Vec<String> = (n..2 * n).map(|i| description.state_name(i)).collect();
+        let index = names.iter().position(|x| x == name).ok_or_else(|| {
+            let rates = &names[n..];
             ExpressionError::UnknownCoordinate {
                 option: "--init".to_string(),
                 name: name.to_string(),
@@ -585,7 +617,11 @@ fn resolve(
     for (i, c) in model.description().coordinate_names().iter().enumerate() {
         known.push((c.to_string(), Source::State(i)));
         known.push((model.description().state_name(n + i), Source::State(n + i)));
-        known.push((format!("{c}_ddot"), Source::Acceleration(i)));
+        // In generalized speeds the accelerations solved for are the speeds' rates `u̇`,
+        // not `q̈`: no `x_ddot` there.
+        if !model.description().has_speeds() {
+            known.push((format!("{c}_ddot"), Source::Acceleration(i)));
+        }
     }
     for (i, c) in model.description().constraint_names().iter().enumerate() {
         known.push((format!("lambda_{c}"), Source::Multiplier(i)));

@@ -406,3 +406,50 @@ fn the_kinematic_equations_name_an_offset() {
         "{text}"
     );
 }
+
+/// Where a name or a formula means the coordinates' rates, a model in speeds gets a message,
+/// not the speeds read as rates: speeds that depend on `t` (rest moves with `t`) are not
+/// linearised, `x_ddot` is not offered to an added event (the state's accelerations are
+/// `u̇`), an output that reads a rate is refused at its place, and the free response's
+/// `--init` takes the linearisation's `x_dot` (its state is `(δq, δq̇)`) and refuses a speed.
+#[test]
+fn what_means_the_rates_is_not_read_from_the_speeds() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let moving = written(
+        &dir,
+        "moving.yaml",
+        "name: moving\nparameters: { m: 2, k: 5, v: 0.4 }\ncoordinates: [x]\nspeeds: { u: x_dot + v*t }\npoints: { P: [x, 0] }\nbodies: { ball: { mass: m, at: P } }\nforces: { spring: { at: P, vector: [-k*x, 0] } }\n",
+    );
+    let out = eomgen(&["modes", &moving]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(err.contains("the generalized speeds depend on t"), "{err}");
+    let body = fixture("free_rigid_body_speeds.yaml");
+    let out = eomgen(&["simulate", &body, "--event", "theta_ddot"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(err.contains("theta_ddot"), "{err}");
+    let output = written(
+        &dir,
+        "output.yaml",
+        "name: output\nparameters: { m: 2, k: 5 }\ncoordinates: [x]\nspeeds: { u: 2*x_dot }\npoints: { P: [x, 0] }\nbodies: { ball: { mass: m, at: P } }\nforces: { spring: { at: P, vector: [-k*x, 0] } }\noutputs: { e: m*x_dot^2/2 }\n",
+    );
+    let out = eomgen(&["simulate", &output]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("output.yaml:8:17: output `e` reads the rate `x_dot`, but a model in generalized speeds has the speeds in its state"),
+        "{err}"
+    );
+    let hanging = fixture("hanging_body_speeds.yaml");
+    eomgen_ok(&[
+        "study",
+        "free-response",
+        &hanging,
+        "--init",
+        "theta_dot=0.1",
+    ]);
+    let out = eomgen(&["study", "free-response", &hanging, "--init", "w1=0.1"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("rates: phi_dot, theta_dot, psi_dot"), "{err}");
+}

@@ -55,6 +55,10 @@ pub struct ModelDescription {
     /// and `q̇ = W(q, t) (u − Z(q, t))` comes from the model's
     /// `coordinate_rates` (Kane and Levinson, *Dynamics: Theory and Applications*, §2.12).
     pub speeds: List<Text>,
+    /// Whether the speeds' coefficients or offsets depend on `t` explicitly
+    /// (`u = Y(q, t) q̇ + Z(q, t)`): rest (`q̇ = 0`) then moves with `t` in the speeds, and the
+    /// linearisation at rest is refused.
+    pub speeds_depend_on_time: bool,
     /// The parameters, in file order, with their default values.
     pub parameters: List<Parameter>,
     /// Names of the model's points, in file order (empty for the energy form).
@@ -164,6 +168,7 @@ impl ModelDescription {
         summary: Cow::Borrowed(""),
         coordinates: Cow::Borrowed(&[]),
         speeds: Cow::Borrowed(&[]),
+        speeds_depend_on_time: false,
         parameters: Cow::Borrowed(&[]),
         points: Cow::Borrowed(&[]),
         draw_lines: Cow::Borrowed(&[]),

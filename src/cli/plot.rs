@@ -718,13 +718,25 @@ pub fn phase_portrait(
     solution: &Solution,
     note: Option<&str>,
 ) -> Result<(), String> {
-    let title = format!("{}: phase portrait", model.description().name);
+    let d = model.description();
+    let title = format!("{}: phase portrait", d.name);
+    // In generalized speeds the state's second half is `u`, drawn against the coordinate
+    // under its own name (`w1 vs theta`).
+    let axis = if d.has_speeds() {
+        "u"
+    } else {
+        "q̇ (m/s or rad/s)"
+    };
+    let n = d.num_dofs();
     per_coordinate(
         path,
-        &Chart::linear(&title, "q (m or rad)", "q̇ (m/s or rad/s)"),
+        &Chart::linear(&title, "q (m or rad)", axis),
         model,
         solution,
-        |name| format!("{name}_dot vs {name}"),
+        |name| {
+            let i = d.coordinate_index(name).unwrap_or(0);
+            format!("{} vs {name}", d.state_name(n + i))
+        },
         |_, y, i, n| (y[i], y[n + i]),
         note,
     )

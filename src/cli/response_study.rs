@@ -10,7 +10,7 @@ use plotters::prelude::*;
 use super::error::CliError;
 use super::operating_point::{modal_failure, point_failure};
 use super::plot::{self, Series};
-use eomgen::expressions::set_initial_values;
+use eomgen::expressions::set_linearized_values;
 
 /// Parses `--init NAME=VALUE,…` (repeatable, as `simulate --init`) into `(δq₀, δq̇₀)`,
 /// starting from zeros (`None` without `--init`: the study's default).
@@ -24,7 +24,7 @@ pub(super) fn parse_init(
     // The deviation from rest, as `--init` sets a state: [δq₀; δq̇₀] from zeros.
     let n = model.num_dofs();
     let mut y = vec![0.0; 2 * n];
-    set_initial_values(model, &mut y, init).map_err(super::values::usage)?;
+    set_linearized_values(model, &mut y, init).map_err(super::values::usage)?;
     let v0 = y.split_off(n);
     let q0 = y;
     Ok(Some(InitialDeviation { q: q0, qdot: v0 }))

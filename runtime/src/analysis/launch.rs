@@ -84,6 +84,15 @@ pub enum LaunchError {
         /// The model's coordinates.
         known: Vec<String>,
     },
+    /// The model is in generalized speeds: the study reads the launch's velocity (the apex,
+    /// the landing angle) as the coordinates' rates, which its state does not hold.
+    #[error(
+        "`{model}` is in generalized speeds, and the launch study reads the velocity as the coordinates' rates: study the model in the rates (remove `speeds`)"
+    )]
+    InSpeeds {
+        /// The model's name.
+        model: String,
+    },
     /// A launch speed that is not a positive finite number.
     #[error("a launch speed must be a positive number, got {speed}")]
     InvalidSpeed {
@@ -688,6 +697,9 @@ pub fn launch_study(
 ) -> Result<LaunchStudy, LaunchError> {
     let d = model.description();
     let name = d.name.to_string();
+    if d.has_speeds() {
+        return Err(LaunchError::InSpeeds { model: name });
+    }
     let parameters: Vec<String> = d.parameters.iter().map(|p| p.name.to_string()).collect();
     let coordinates: Vec<String> = d.coordinate_names().iter().map(|c| c.to_string()).collect();
     let parameter_index = |role: &'static str, wanted: &str| {

@@ -442,12 +442,8 @@ pub fn periodic_orbit(
     let symmetries = (shooting.n + usize::from(shooting.free_period)) - rank_used;
     let multipliers = classify_multipliers(model, &current, options, time_dependent)?;
     let orbit = sample_orbit(model, &current, options, &mut stats)?;
-    let coordinates = model.description().coordinate_names();
-    let state_names = coordinates
-        .iter()
-        .map(|c| c.to_string())
-        .chain(coordinates.iter().map(|c| format!("{c}_dot")))
-        .collect();
+    let d = model.description();
+    let state_names = (0..2 * d.num_dofs()).map(|i| d.state_name(i)).collect();
     let residual_max = current.residual.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     Ok(PeriodicOrbit {
         model: name,

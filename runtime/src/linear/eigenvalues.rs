@@ -111,10 +111,33 @@ pub struct LinearStability {
     pub rounded_real_part: f64,
 }
 
-/// The largest skew part of `C`, relative to the linearisation's scale, that
-/// [`linear_stability`] takes for rounding rather than gyroscopic terms (about 50 units of
-/// rounding: a real gyroscopic coupling is a spin rate times an inertia, orders above).
+/// The largest skew part of `C`, relative to the linearisation's scale
+/// (`above_rounding`), that [`linear_stability`] takes for rounding rather than gyroscopic
+/// terms (about 50 units of rounding: a real gyroscopic coupling is a spin rate times an
+/// inertia, orders above).
 const GYROSCOPIC_ROUNDING: f64 = 1e-14;
+
+/// Whether the skew part `G` of `C` is above rounding of the linearisation's scale: each
+/// matrix scaled by `D⁻¹ · D⁻¹` with `D = diag(M)^½`, so that every entry is in 1/s (`C`, `G`)
+/// or 1/s² (`K`) whatever the coordinates' units, `max |G̃|` is compared with
+/// [`GYROSCOPIC_ROUNDING`] times `max |C̃| + √max |K̃|`. A model in generalized speeds,
+/// linearised through products such as `Yᵀ F_u Y`, leaves a skew part of 1e-90 of that where
+/// the same model in the rates has none.
+fn above_rounding(lin: &Linearization, gyroscopic_part: &DMatrix<f64>) -> bool {
+    let m = &lin.mass_matrix;
+    let d: Vec<f64> = (0..m.nrows())
+        .map(|i| m[(i, i)].abs().sqrt().max(f64::MIN_POSITIVE))
+        .collect();
+    let scaled_max = |a: &DMatrix<f64>| {
+        (0..a.nrows())
+            .flat_map(|i| (0..a.ncols()).map(move |j| (i, j)))
+            .fold(0.0f64, |top, (i, j)| {
+                top.max((a[(i, j)] / (d[i] * d[j])).abs())
+            })
+    };
+    let scale = scaled_max(&lin.damping_matrix) + scaled_max(&lin.stiffness_matrix).sqrt();
+    scaled_max(gyroscopic_part) > GYROSCOPIC_ROUNDING * scale
+}
 
 /// Serialises complex numbers as `[re, im]`.
 fn complex_pairs<S: serde::Serializer>(v: &[Complex<f64>], s: S) -> Result<S::Ok, S::Error> {
@@ -154,11 +177,7 @@ pub fn linear_stability(lin: &Linearization) -> Result<LinearStability, ModalErr
     let damping_part = (c + c.transpose()) * 0.5;
     let gyroscopic_part = (c - c.transpose()) * 0.5;
     let (eigenvalues, rounded_real_part) = rounded_state_eigenvalues(lin)?;
-    // A skew part at rounding of the linearisation's scale (`|C|`, or `√(|K| |M|)`, a
-    // frequency times a mass) is not gyroscopic: products such as `Yᵀ F_u Y` of a model in
-    // generalized speeds leave 1e-16 of it where the model in rates has none.
-    let scale = c.amax() + (lin.stiffness_matrix.amax() * lin.mass_matrix.amax()).sqrt();
-    let gyroscopic = gyroscopic_part.amax() > GYROSCOPIC_ROUNDING * scale;
+    let gyroscopic = above_rounding(lin, &gyroscopic_part);
     let gyroscopic_frequencies = if gyroscopic {
         let conservative = Linearization {
             damping_matrix: gyroscopic_part.clone(),

@@ -70,6 +70,11 @@ pub fn find_equilibrium(
     // kinematic equations are singular, a residual no step accepts).
     let speeds = model.description().has_speeds();
     let rest = |q: &[f64]| super::speeds::rest(model, q, t);
+    if speeds {
+        // Speeds that depend on t, or kinematic equations singular at the guess, are said so
+        // rather than left to Newton's failure.
+        rest(guess)?;
+    }
     let state = |q: &[f64]| -> Vec<f64> {
         super::speeds::rest_state(model, q, t)
             .unwrap_or_else(|_| q.iter().copied().chain(vec![f64::NAN; n]).collect())

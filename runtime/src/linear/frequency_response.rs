@@ -1391,11 +1391,8 @@ fn simulate_inner(
         .map(|j| settling_time + period * j as f64 / options.samples_per_period as f64)
         .collect();
     let t_end = settling_time + period * options.periods as f64;
-    let y0: Vec<f64> = equilibrium
-        .iter()
-        .copied()
-        .chain(std::iter::repeat_n(0.0, n))
-        .collect();
+    // At rest at the equilibrium (in generalized speeds `u = Z(q)`).
+    let y0 = super::speeds::rest_state(&*model, equilibrium, 0.0).map_err(ModalError::from)?;
     let integrator_options = IntegratorOptions::default()
         .with_rtol(options.rtol)
         .with_atol(options.atol)

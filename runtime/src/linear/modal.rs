@@ -212,6 +212,12 @@ pub enum ModalError {
         /// The largest `|q̇ᵢ|` from the kinematic equations.
         speed: f64,
     },
+    /// A model whose generalized speeds depend on `t` (`u = Y(q, t) q̇ + Z(q, t)` with `t` in
+    /// `Y` or `Z`): its rest moves with `t` in the speeds.
+    #[error(
+        "the generalized speeds depend on t (u = Y(q, t) q' + Z(q, t)), so rest (q' = 0) moves with t in the speeds: equilibria and linearisations are found in the coordinates' rates"
+    )]
+    SpeedsDependOnTime,
     /// The kinematic equations of a model in generalized speeds are singular there: `W` is
     /// not invertible or not finite (Euler angles at gimbal lock).
     #[error(
@@ -246,6 +252,7 @@ impl From<super::speeds::KinematicsError> for ModalError {
         use super::speeds::KinematicsFailure as F;
         match e.kind {
             F::Singular => ModalError::SingularKinematics { q: e.q },
+            F::TimeDependent => ModalError::SpeedsDependOnTime,
             F::Moving(speed) => ModalError::SpeedsInMotion { speed },
             F::SingularMassMatrix => ModalError::SingularMassMatrix { q: e.q },
             F::NonFinite => ModalError::NonFinite { q: e.q },

@@ -5,7 +5,8 @@
 //! The speeds are `u = Y(q, t) q̇ + Z(q, t)` and the model's kinematic equations
 //! `q̇ = K(q, u, t) = W (u − Z)`, `W = Y⁻¹` (Kane and Levinson, *Dynamics: Theory and
 //! Applications*, 1985, §2.12). Everything below comes from `K` and its exact Jacobians
-//! `K_q = ∂K/∂q`, `W = ∂K/∂u`, with `t` frozen as [`super::modal::linearize`] freezes it:
+//! `K_q = ∂K/∂q`, `W = ∂K/∂u`, for speeds whose `Y` and `Z` do not depend on `t` (others are
+//! refused: at their rest `u̇ = Y q̈ + ∂Z/∂t`):
 //!
 //! - at rest `q̇ = 0`, so `u = Z = −Y K(q, 0)`, and `P = ∂Z/∂q = −Y K_q(q, Z)`;
 //! - near rest `δu = Y δq̇ + P δq` and `δu̇ = Y δq̈ + P δq̇ + E δq`, where `E δq` is
@@ -40,6 +41,9 @@ pub(crate) struct KinematicsError {
 pub(crate) enum KinematicsFailure {
     /// `W` is not finite or not invertible.
     Singular,
+    /// The speeds' coefficients or offsets depend on `t`
+    /// ([`crate::ModelDescription::speeds_depend_on_time`]).
+    TimeDependent,
     /// The state given is not at rest: its largest `|q̇ᵢ|`.
     Moving(f64),
     /// `M_u` is not positive definite.
@@ -75,8 +79,12 @@ pub(crate) struct Rest {
 ///
 /// # Errors
 /// [`KinematicsFailure::Singular`] where `W` is not finite or not invertible (its smallest
-/// singular value below `1e-12` of its largest).
+/// singular value below `1e-12` of its largest); [`KinematicsFailure::TimeDependent`] for
+/// speeds that depend on `t` (at rest `u̇ = Y q̈ + ∂Z/∂t`, which these formulas leave out).
 pub(crate) fn rest(model: &dyn ModelInfo, q: &[f64], t: f64) -> Result<Rest, KinematicsError> {
+    if model.description().speeds_depend_on_time {
+        return Err(failure(q, KinematicsFailure::TimeDependent));
+    }
     let n = q.len();
     let singular = || failure(q, KinematicsFailure::Singular);
     let mut state: Vec<f64> = q

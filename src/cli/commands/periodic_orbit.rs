@@ -233,25 +233,15 @@ fn guess(model: &dyn ModelInfo, items: &[String]) -> Result<Vec<f64>, CliError> 
     let lookup = parameter_lookup(model);
     for item in items.iter().flat_map(|s| split_list(s)) {
         let (name, text) = split_assignment(item, "--guess").map_err(usage)?;
-        let index = coordinates
-            .iter()
-            .position(|c| *c == name)
-            .or_else(|| {
-                let base = name.strip_suffix("_dot")?;
-                coordinates.iter().position(|c| *c == base).map(|i| n + i)
-            })
-            .ok_or_else(|| {
-                CliError::usage(format!(
-                    "--guess {name}: `{}` has no coordinate or rate `{name}`; its coordinates are {} and their rates {}",
-                    model.description().name,
-                    coordinates.join(", "),
-                    coordinates
-                        .iter()
-                        .map(|c| format!("{c}_dot"))
-                        .collect::<Vec<_>>()
-                        .join(", ")
-                ))
-            })?;
+        let d = model.description();
+        let index = d.state_index(name).ok_or_else(|| {
+            CliError::usage(format!(
+                "--guess {name}: `{}` has no coordinate or rate `{name}`; its coordinates are {} and their rates {}",
+                d.name,
+                coordinates.join(", "),
+                (n..2 * n).map(|i| d.state_name(i)).collect::<Vec<_>>().join(", ")
+            ))
+        })?;
         y[index] = evaluate(text, &format!("--guess {name}"), &lookup)?;
     }
     Ok(y)

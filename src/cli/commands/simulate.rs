@@ -591,8 +591,9 @@ fn print_events(model: &dyn ModelInfo, solution: &Solution) {
             .enumerate()
             .map(|(i, c)| {
                 format!(
-                    "{c} = {:.9e}, {c}_dot = {:.9e}",
+                    "{c} = {:.9e}, {} = {:.9e}",
                     num(e.y[i]),
+                    model.description().state_name(n + i),
                     num(e.y[n + i])
                 )
             })
@@ -640,7 +641,8 @@ const EVENTS_HEADER: &str = "event,direction,terminal,t";
 
 /// Whether `bytes` is an events CSV that eomgen wrote, for any model: its first line is the
 /// exact header [`write_events_csv`] writes, [`EVENTS_HEADER`] then the coordinates `c₁…cₙ`
-/// and their rates `c₁_dot…cₙ_dot`.
+/// and their rates `c₁_dot…cₙ_dot` (or, in generalized speeds, `n` speeds, no coordinate's
+/// name among them).
 fn is_events_csv(bytes: &[u8]) -> bool {
     let Some(line) = bytes.split(|&b| b == b'\n').next() else {
         return false;
@@ -653,11 +655,11 @@ fn is_events_csv(bytes: &[u8]) -> bool {
     };
     let columns: Vec<&str> = columns.split(',').collect();
     let (coordinates, rates) = columns.split_at(columns.len() / 2);
+    // The rates `c_dot` of the coordinates, or (generalized speeds) names of their own.
     columns.len().is_multiple_of(2)
-        && coordinates
-            .iter()
-            .zip(rates)
-            .all(|(c, r)| !c.is_empty() && r.strip_suffix("_dot") == Some(c))
+        && columns.iter().all(|c| !c.is_empty())
+        && (coordinates.iter().zip(rates))
+            .all(|(c, r)| r.strip_suffix("_dot") == Some(c) || !coordinates.contains(r))
 }
 
 /// The located events as CSV: name, direction, t, coordinates, rates.

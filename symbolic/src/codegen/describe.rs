@@ -39,6 +39,7 @@ pub fn describe(model: &SymbolicModel, eom: &EquationsOfMotion, mathml: bool) ->
         speeds: (model.speeds.iter())
             .flat_map(|s| s.names.iter().map(|u| text(u)))
             .collect(),
+        speeds_depend_on_time: model.speeds_depend_on_time(),
         parameters: model
             .parameters
             .iter()
@@ -202,6 +203,7 @@ pub fn description_tokens(
     let summary = text(&d.summary);
     let coordinates = texts(&d.coordinates);
     let speeds = texts(&d.speeds);
+    let speeds_depend_on_time = d.speeds_depend_on_time;
     let parameters = d
         .parameters
         .iter()
@@ -319,6 +321,7 @@ pub fn description_tokens(
             summary: #summary,
             coordinates: #coordinates,
             speeds: #speeds,
+            speeds_depend_on_time: #speeds_depend_on_time,
             parameters: #parameters,
             points: #points,
             draw_lines: #draw_lines,

@@ -343,6 +343,15 @@ impl SymbolicModel {
                 .any(|w| self.arena.depends_on(*w, self.time_id))
     }
 
+    /// Whether the model is in generalized speeds whose coefficients `Y` or offsets `Z`
+    /// depend on `t` explicitly: rest, `q̇ = 0`, is then `u = Z(q, t)` moving with `t`, and
+    /// `u̇ = Y q̈ + Ż` there.
+    pub fn speeds_depend_on_time(&self) -> bool {
+        (self.speeds.iter())
+            .flat_map(|s| s.inverse.iter().chain(&s.offsets))
+            .any(|e| self.arena.depends_on(*e, self.time_id))
+    }
+
     /// Whether the model is in generalized speeds with an offset `Z(q, t) ≠ 0` in one of them.
     pub fn speeds_have_offsets(&self) -> bool {
         (self.speeds.iter())

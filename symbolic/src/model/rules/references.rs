@@ -300,11 +300,9 @@ impl Checker<'_> {
         }
         self.angular_velocities = false;
         for c in &checks.conserved {
-            self.resolve(
-                &c.value,
-                Depends::Motion,
-                &format!("conserved quantity `{}`", c.name.value),
-            );
+            let what = format!("conserved quantity `{}`", c.name.value);
+            self.resolve(&c.value, Depends::Motion, &what);
+            self.no_rates_beside_speeds(&c.value, &what);
         }
         self.angular_velocities = true;
     }
@@ -399,10 +397,19 @@ impl Checker<'_> {
                 &format!("the value of `{}` in `final_state`", k.value),
             );
             let n = k.value.as_str();
+            let speeds = !self.file.speeds.is_empty();
             if self.sets.coords.contains(n)
-                || self.sets.rates.contains(n)
+                || (self.sets.rates.contains(n) && !speeds)
+                || self.sets.speeds.contains(n)
                 || self.incomplete.has_section("coordinates")
             {
+                continue;
+            }
+            if speeds && self.sets.rates.contains(n) {
+                self.error(
+                    Diagnostic::new(k.location, format!("`{n}` in `final_state` is a rate, but a model in generalized speeds has the speeds in its state"))
+                        .with_help("give the final values of the coordinates and the speeds"),
+                );
                 continue;
             }
             let mut candidates: Vec<&str> = self.coords.clone();
@@ -443,6 +450,30 @@ impl Checker<'_> {
                 );
             }
             self.resolve(&o.value, Depends::Motion, &format!("output `{n}`"));
+            self.no_rates_beside_speeds(&o.value, &format!("output `{n}`"));
+        }
+    }
+
+    /// With generalized speeds, an expression evaluated on the simulated state (an output, a
+    /// conserved quantity) reads the speeds, which the state holds, not the rates: a rate it
+    /// names is an error at its place.
+    fn no_rates_beside_speeds(&mut self, e: &Expr, what: &str) {
+        if self.file.speeds.is_empty() {
+            return;
+        }
+        let mut ids = Vec::new();
+        identifiers(e, &mut ids);
+        if let Some((rate, at)) = ids
+            .iter()
+            .find(|(n, _)| self.sets.rates.contains(n.as_str()))
+        {
+            let speeds: Vec<&str> = (self.file.speeds.iter())
+                .map(|s| s.name.value.as_str())
+                .collect();
+            self.error(
+                Diagnostic::new(*at, format!("{what} reads the rate `{rate}`, but a model in generalized speeds has the speeds in its state"))
+                    .with_help(format!("write it with the speeds ({}) and the coordinates", speeds.join(", "))),
+            );
         }
     }
 }
