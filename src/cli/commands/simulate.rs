@@ -658,8 +658,10 @@ fn is_events_csv(bytes: &[u8]) -> bool {
     // The rates `c_dot` of the coordinates, or (generalized speeds) names of their own.
     columns.len().is_multiple_of(2)
         && columns.iter().all(|c| !c.is_empty())
-        && (coordinates.iter().zip(rates))
-            .all(|(c, r)| r.strip_suffix("_dot") == Some(c) || !coordinates.contains(r))
+        && (coordinates.iter().zip(rates)).all(|(c, r)| match r.strip_suffix("_dot") {
+            Some(rate) => rate == *c,
+            None => !coordinates.contains(r),
+        })
 }
 
 /// The located events as CSV: name, direction, t, coordinates, rates.
@@ -752,6 +754,7 @@ mod tests {
         for ours in [
             "event,direction,terminal,t,q,q_dot\n",
             "event,direction,terminal,t,x,theta,x_dot,theta_dot\nhit,rising,true,1e0,0,0,0,0\n",
+            "event,direction,terminal,t,phi,theta,w1,w2\n",
         ] {
             assert!(is_events_csv(ours.as_bytes()), "{ours}");
         }
@@ -763,6 +766,7 @@ mod tests {
             "event,direction,terminal,t,q,p_dot\n",
             "event,direction,terminal,time,q,q_dot\n",
             "event,direction,terminal,t,q,q_dot,extra\n",
+            "event,direction,terminal,t,phi,theta,w1,phi\n",
             "# event,direction,terminal,t,q,q_dot\n",
         ] {
             assert!(!is_events_csv(theirs.as_bytes()), "{theirs}");
