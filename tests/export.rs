@@ -118,7 +118,10 @@ fn reference(model: &JitModel, state: &State) -> Values {
         qdd.iter().all(|x| x.is_finite())
     };
     assert!(solved, "{}: the state's linear system is singular", d.name);
-    out.push(("ydot".into(), [qd.to_vec(), qdd].concat()));
+    // In generalized speeds `qd` is `u`, and `q̇` comes from the kinematic equations.
+    let mut rates = vec![0.0; n];
+    model.coordinate_rates(q, qd, t, &mut rates);
+    out.push(("ydot".into(), [rates, qdd].concat()));
     if m > 0 {
         out.push(("lambda".into(), workspace.multipliers.clone()));
     }
@@ -156,6 +159,24 @@ fn solve(mut a: Vec<f64>, mut b: Vec<f64>) -> Vec<f64> {
 fn array(values: &[f64]) -> String {
     let items: Vec<String> = values.iter().map(|x| format!("{x:?}")).collect();
     format!("{{{}}}", items.join(", "))
+}
+
+/// The files exported: every bundled model and the two fixtures in generalized speeds (whose
+/// `qd` is `u` and whose `rhs` takes `q̇` from `coordinate_rates`), as `(name, file, text)`.
+fn exported_files() -> Vec<(String, String, String)> {
+    let bundled = eomgen::models::ALL.iter().map(|entry| {
+        (
+            entry.name.to_string(),
+            entry.file.to_string(),
+            entry.source().to_string(),
+        )
+    });
+    let fixtures = ["free_rigid_body_speeds", "heavy_top_speeds"].map(|name| {
+        let file = format!("{}/tests/fixtures/{name}.yaml", env!("CARGO_MANIFEST_DIR"));
+        let text = std::fs::read_to_string(&file).unwrap();
+        (name.to_string(), file, text)
+    });
+    bundled.chain(fixtures).collect()
 }
 
 /// The C driver's statements for one model at one state: each output printed on a line,
@@ -306,15 +327,15 @@ fn exported_c_computes_what_eomgen_computes_on_every_bundled_model() {
     );
     let mut expected: Values = Vec::new();
     let mut models = Vec::new();
-    for (k, entry) in eomgen::models::ALL.iter().enumerate() {
-        let code = export(entry.file, entry.source(), Language::C)
-            .unwrap_or_else(|e| panic!("{}: {e}", entry.name));
+    let files = exported_files();
+    for (k, (name, file, text)) in files.iter().enumerate() {
+        let code = export(file, text, Language::C).unwrap_or_else(|e| panic!("{name}: {e}"));
         source.push_str(&code);
-        let model = entry.model().unwrap();
+        let model = JitModel::from_source(file, text).unwrap();
         for state in states(&model, 1000 + k as u64) {
-            main.push_str(&driver(entry.name, &model, &state));
+            main.push_str(&driver(name, &model, &state));
             let values = reference(&model, &state);
-            models.extend(std::iter::repeat_n(entry.name, values.len()));
+            models.extend(std::iter::repeat_n(name.as_str(), values.len()));
             expected.extend(values);
         }
     }
@@ -341,7 +362,7 @@ fn exported_c_computes_what_eomgen_computes_on_every_bundled_model() {
     let worst = compare("C", &models, &got, &expected);
     println!(
         "{} models, {} outputs: worst relative difference {worst:.2e}",
-        eomgen::models::ALL.len(),
+        files.len(),
         got.len()
     );
 }

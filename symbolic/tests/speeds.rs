@@ -249,8 +249,7 @@ fn strip_section(source: &str, key: &str) -> String {
 
 /// The messages of a file whose speeds are wrong, each at its place: nonlinear, dependent,
 /// too few, beside constraints, with both initial rates and speeds; and a model with speeds
-/// is not exported (its exported functions take `(q, q̇)`), said so rather than exported in
-/// the wrong state.
+/// is exported with its kinematic equations (`coordinate_rates`).
 #[test]
 fn mistaken_speeds_are_located() {
     let lowering_error = |source: &str| -> String {
@@ -352,16 +351,9 @@ fn mistaken_speeds_are_located() {
         "m.yaml",
         eomgen_symbolic::codegen::export::Language::C,
         &[],
-    );
-    let Err(eomgen_symbolic::codegen::GenerateError::Diagnostics(d)) = exported else {
-        panic!("a model with speeds exported")
-    };
-    assert!(
-        d[0].message
-            .contains("a model in generalized speeds is not exported yet"),
-        "{}",
-        d[0].message
-    );
+    )
+    .expect("a model in speeds is exported");
+    assert!(exported.contains("_coordinate_rates("), "{exported}");
 }
 
 /// A speed with an offset, `u = ẋ + v0` for a point at `x + v0 t` pulled by `−k x`:

@@ -138,8 +138,16 @@ impl Exported<'_> {
         }
         let _ = writeln!(
             s,
-            "    return status;\n}}\n\n/* dy/dt = [qd; q''] ({two}) at (t, y): the status of {prefix}_accelerations. */\nint {prefix}_rhs(double t, const double *y, const double *p, double *ydot)\n{{\n    double x[{k}];\n    int i, status = {prefix}_accelerations(t, y, y + {n}, p, x);\n    if (status != 0) {{\n        return status;\n    }}\n    for (i = 0; i < {n}; ++i) {{\n        ydot[i] = y[{n} + i];\n        ydot[{n} + i] = x[i];\n    }}\n    return 0;\n}}",
-            two = 2 * n
+            "    return status;\n}}\n\n/* dy/dt = [qd; q''] ({two}) at (t, y): the status of {prefix}_accelerations. */\nint {prefix}_rhs(double t, const double *y, const double *p, double *ydot)\n{{\n    double x[{k}];\n    int i, status = {prefix}_accelerations(t, y, y + {n}, p, x);\n    if (status != 0) {{\n        return status;\n    }}\n{rates}    for (i = 0; i < {n}; ++i) {{\n{copy}        ydot[{n} + i] = x[i];\n    }}\n    return 0;\n}}",
+            two = 2 * n,
+            rates = match self.speeds.is_empty() {
+                true => String::new(),
+                false => format!("    {prefix}_coordinate_rates(t, y, y + {n}, p, ydot);\n"),
+            },
+            copy = match self.speeds.is_empty() {
+                true => format!("        ydot[i] = y[{n} + i];\n"),
+                false => String::new(),
+            },
         );
         if m > 0 {
             let _ = writeln!(

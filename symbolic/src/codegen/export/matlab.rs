@@ -24,6 +24,7 @@ const RESERVED: &[&str] = &[
     "constraint_residuals",
     "constraint_jacobian",
     "constraint_gamma",
+    "coordinate_rates",
     "break",
     "case",
     "catch",
@@ -119,10 +120,14 @@ impl Exported<'_> {
         let (n, m) = (self.n(), self.m());
         let _ = writeln!(
             s,
-            "function ydot = rhs(t, y, p)\n% dy/dt = [qd; q''] ({}).\nif nargin < 3 || isempty(p), p = parameters(); end\nq = y(1:{n});\nqd = y({}:{});\nx = accelerations(t, q, qd, p);\nydot = [qd; x(1:{n})];\nend\n",
+            "function ydot = rhs(t, y, p)\n% dy/dt = [{rates}; q''] ({}).\nif nargin < 3 || isempty(p), p = parameters(); end\nq = y(1:{n});\nqd = y({}:{});\nx = accelerations(t, q, qd, p);\nydot = [{rates}; x(1:{n})];\nend\n",
             2 * n,
             n + 1,
-            2 * n
+            2 * n,
+            rates = match self.speeds.is_empty() {
+                true => "qd",
+                false => "coordinate_rates(t, q, qd, p)",
+            },
         );
         if m > 0 {
             let _ = writeln!(

@@ -24,8 +24,13 @@
 //! | `mass_matrix_product_jacobian(t, q, a, p)` | `∂(M a)/∂q` (`n × n`) |
 //! | `kinetic_energy(t, q, qd, p)`, `potential_energy(t, q, p)` | `T`, `V` |
 //! | `point_positions(t, q, p)` | `[x, y, z]` of each point (`points × 3`) |
+//! | `coordinate_rates(t, q, qd, p)` | with generalized speeds, `q̇ = W (u − Z)` (`n`) |
 //! | `constraint_residuals(t, q, p)` | `Φ` (`m_h`), with constraints only |
 //! | `constraint_jacobian(t, q, p)`, `constraint_gamma(t, q, qd, p)` | `J` (`m × n`), `γ` (`m`), with constraints only |
+//!
+//! A model in generalized speeds (`speeds:`) has the speeds `u` where the others have `q̇`:
+//! its state is `y = [q; u]`, every `qd` argument is `u`, `M` and `F` are Kane's
+//! `M u̇ = F`, and `rhs` returns `[q̇; u̇]` with `q̇` from `coordinate_rates`.
 //!
 //! Matrices are row-major arrays in C (`M[i*n + j]`), two-dimensional arrays in NumPy and
 //! matrices in MATLAB. Contacts, impacts and events are not exported: they need the
@@ -91,7 +96,7 @@ impl Language {
 ///
 /// # Errors
 /// [`GenerateError::Diagnostics`] for a model that cannot be derived (as `eomgen::model!`
-/// reports it) or that is in generalized speeds; [`GenerateError::Emit`] for a name of `values` that is not a parameter, or
+/// reports it); [`GenerateError::Emit`] for a name of `values` that is not a parameter, or
 /// if a function reads an input its exported signature does not have (a bug of the
 /// exporter, named in the message).
 pub fn export(
@@ -100,15 +105,6 @@ pub fn export(
     language: Language,
     values: &[(String, f64)],
 ) -> Result<String, GenerateError> {
-    if let Some(first) = file.speeds.first() {
-        return Err(GenerateError::Diagnostics(vec![
-            crate::model::Diagnostic::new(
-                first.name.location,
-                "exported code takes the state (q, q'): a model in generalized speeds is not exported yet",
-            )
-            .with_help("to export it, remove `speeds` (the same model in the coordinates' rates)"),
-        ]));
-    }
     let (program, derivation) = ModelProgram::from_file(file)?;
     let jacobians = derivation.jacobians();
     let mut model = Exported::new(&program, &jacobians, source_display);
@@ -297,6 +293,8 @@ struct Exported<'a> {
     name: String,
     source: String,
     coordinates: Vec<String>,
+    /// The generalized speeds' names, empty in the coordinates' rates.
+    speeds: Vec<String>,
     parameters: Vec<(String, f64)>,
     constraints: Vec<String>,
     holonomic: usize,
@@ -395,10 +393,22 @@ impl<'a> Exported<'a> {
             });
         }
         functions.extend(constraint_functions(program));
+        if d.has_speeds() {
+            functions.push(Function {
+                name: "coordinate_rates",
+                doc: format!(
+                    "the coordinates' rates q' = W(q, t) (u - Z(q, t)) ({n}) from the speeds u (qd)"
+                ),
+                args: STATE,
+                tape: &program.coordinate_rates.tape,
+                outputs: vec![Output::vector("qdot", &outputs(&program.coordinate_rates))],
+            });
+        }
         Exported {
             name: identifier(&d.name),
             source: source.to_string(),
             coordinates: d.coordinates.iter().map(|c| c.to_string()).collect(),
+            speeds: d.speeds.iter().map(|u| u.to_string()).collect(),
             parameters: d
                 .parameters
                 .iter()
@@ -446,11 +456,20 @@ impl<'a> Exported<'a> {
             format!("State y = [q; qd] ({} values):", 2 * n),
         ];
         for (i, c) in self.coordinates.iter().enumerate() {
+            let second = match self.speeds.get(i) {
+                Some(u) => format!("{u} (a generalized speed)"),
+                None => format!("{c}_dot"),
+            };
             lines.push(format!(
-                "  {} = {c}, {} = {c}_dot",
+                "  {} = {c}, {} = {second}",
                 entry("q", i),
                 entry("qd", i)
             ));
+        }
+        if !self.speeds.is_empty() {
+            lines.push(
+                "qd holds the generalized speeds u: M u' = F are Kane's equations, and rhs takes q' from coordinate_rates.".to_string(),
+            );
         }
         lines.push("Parameters p, in this order, with the file's values:".to_string());
         for (i, (name, value)) in self.parameters.iter().enumerate() {
@@ -493,15 +512,21 @@ impl<'a> Exported<'a> {
                 ""
             }
         ));
-        lines.push(format!(
-            "  rhs(t, y, p): dy/dt = [qd; q''] ({}), q'' {}",
-            2 * n,
-            if m > 0 {
-                "from the constraints' index-1 system"
-            } else {
-                "from M q'' = F"
-            }
-        ));
+        lines.push(match self.speeds.is_empty() {
+            true => format!(
+                "  rhs(t, y, p): dy/dt = [qd; q''] ({}), q'' {}",
+                2 * n,
+                if m > 0 {
+                    "from the constraints' index-1 system"
+                } else {
+                    "from M q'' = F"
+                }
+            ),
+            false => format!(
+                "  rhs(t, y, p): dy/dt = [q'; u'] ({}), q' from coordinate_rates, u' from M u' = F",
+                2 * n
+            ),
+        });
         if m > 0 {
             lines.push(format!("  multipliers(t, q, qd, p): lambda ({m})"));
         }

@@ -64,8 +64,12 @@ impl Exported<'_> {
         if m == 0 {
             let _ = writeln!(
                 s,
-                "\ndef rhs(t, y, p=PARAMETERS):\n    \"\"\"dy/dt = [qd; q''] ({}), q'' from M q'' = F.\"\"\"\n    y = np.asarray(y, dtype=float)\n    q, qd = y[:{n}], y[{n}:]\n    M, F = mass_matrix_and_forcing(t, q, qd, p)\n    return np.concatenate((qd, np.linalg.solve(M, F)))",
-                2 * n
+                "\ndef rhs(t, y, p=PARAMETERS):\n    \"\"\"dy/dt = [{rates}; q''] ({}), q'' from M q'' = F.\"\"\"\n    y = np.asarray(y, dtype=float)\n    q, qd = y[:{n}], y[{n}:]\n    M, F = mass_matrix_and_forcing(t, q, qd, p)\n    return np.concatenate(({rates}, np.linalg.solve(M, F)))",
+                2 * n,
+                rates = match self.speeds.is_empty() {
+                    true => "qd",
+                    false => "coordinate_rates(t, q, qd, p)",
+                },
             );
         } else {
             let _ = writeln!(
