@@ -71,7 +71,7 @@ pub enum ExpressionError {
     },
     /// An initial value for a name that is neither a coordinate nor a rate.
     #[error(
-        "{option} {name}: `{model}` has no coordinate or rate `{name}` (coordinates: {coordinates}; rates: {rates})"
+        "{option} {name}: `{model}` has no coordinate or rate `{name}` (coordinates: {coordinates}; {rates})"
     )]
     UnknownCoordinate {
         /// The option (`--init`).
@@ -82,7 +82,8 @@ pub enum ExpressionError {
         model: String,
         /// The coordinates, comma separated.
         coordinates: String,
-        /// The rates, comma separated.
+        /// The state's second half with its label: `rates: x_dot, …`, or `speeds: u, …` (a
+        /// model in generalized speeds, whose state holds them rather than the rates).
         rates: String,
     },
     /// An event's direction that is none of rising, falling, both.
@@ -377,13 +378,18 @@ fn set_named_values(
         let (name, text) = split_assignment(s, "--init")?;
         let value = evaluate(text, &format!("--init {name}"), &parameter_lookup(model))?;
         let index = names.iter().position(|x| x == name).ok_or_else(|| {
-            let rates = &names[n..];
+            let second = &names[n..];
+            // The speeds of a model in generalized speeds, unless the names are a
+            // linearisation's rates (`x_dot`).
+            let speeds = model.description().has_speeds()
+                && !(second.iter().zip(&coordinates)).all(|(r, c)| *r == format!("{c}_dot"));
+            let label = if speeds { "speeds" } else { "rates" };
             ExpressionError::UnknownCoordinate {
                 option: "--init".to_string(),
                 name: name.to_string(),
                 model: model.description().name.to_string(),
                 coordinates: coordinates.join(", "),
-                rates: rates.join(", "),
+                rates: format!("{label}: {}", second.join(", ")),
             }
         })?;
         y[index] = value;

@@ -364,7 +364,7 @@ fn the_command_line_names_the_speeds() {
     );
     let out = eomgen(&["simulate", &body, "--init", "phi_dot=1"]);
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(err.contains("rates: w1, w2, w3"), "{err}");
+    assert!(err.contains("speeds: w1, w2, w3"), "{err}");
 }
 
 /// The partial angular velocities `kinematics --partial` lists for a model in speeds are
@@ -453,7 +453,7 @@ fn what_means_the_rates_is_not_read_from_the_speeds() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(
-        err.contains("output.yaml:8:17: output `e` reads the rate `x_dot`, but a model in generalized speeds has the speeds in its state"),
+        err.contains("output.yaml:8:17: output `e` reads `x_dot`, a function of the rates, but a model in generalized speeds has the speeds in its state"),
         "{err}"
     );
     let hanging = fixture("hanging_body_speeds.yaml");
@@ -467,4 +467,42 @@ fn what_means_the_rates_is_not_read_from_the_speeds() {
     let out = eomgen(&["study", "free-response", &hanging, "--init", "w1=0.1"]);
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("rates: phi_dot, theta_dot, psi_dot"), "{err}");
+}
+
+/// Speeds with large offsets in the coordinates (`u₁ = ẋ₁ + a x₂ + b x₁`, `a` = 300) make the
+/// products `Yᵀ K Y` round to a skew part of 1e-12 where the model in rates has none: within
+/// the products' rounding bound it is averaged out, so two uncoupled oscillators stay
+/// symmetric (no flutter, no gyroscopic part) with `ω = √(k/m)` twice, to 1e-12, while a
+/// real Coriolis coupling (a particle on a turntable in speeds with offsets `Ω (−y, x)`)
+/// keeps its `G = 2 m Ω` exactly.
+#[test]
+fn rounding_of_the_speeds_is_not_a_coupling() {
+    let twins = "name: twins\nparameters: { m: 1.3, k: 5.1, a: 300, b: 221.19 }\ncoordinates: [x1, x2]\nspeeds: { u1: x1_dot + a*x2 + b*x1, u2: x2_dot + b*x1 - a*x2 }\npoints: { P1: [x1, 0], P2: [x2, 1] }\nbodies: { b1: { mass: m, at: P1 }, b2: { mass: m, at: P2 } }\nforces: { s1: { at: P1, vector: [-k*x1, 0] }, s2: { at: P2, vector: [-k*x2, 0] } }\n";
+    let model = load("twins.yaml", twins);
+    let lin = eomgen::linearize(model.as_ref(), &[0.0, 0.0], &[0.0, 0.0], 0.0).expect("at rest");
+    assert_eq!(lin.stiffness_asymmetry(), 0.0);
+    let c = &lin.damping_matrix;
+    assert_eq!(c[(0, 1)], c[(1, 0)]);
+    let stability = eomgen::linear_stability(&lin).expect("stability");
+    assert!(stability.gyroscopic_frequencies.is_none());
+    let modes = eomgen::normal_modes(&lin).expect("modes");
+    let omega = (5.1f64 / 1.3).sqrt();
+    for w in &modes.natural_frequencies {
+        assert!((w - omega).abs() < 1e-12 * omega, "{w} vs {omega}");
+    }
+    let turntable = "name: turntable\nparameters: { m: 1.0, k: 5.0, W: 1.0 }\ncoordinates: [x, y]\nspeeds: { u: x_dot - W*y, v: y_dot + W*x }\npoints: { P: [x*cos(W*t) - y*sin(W*t), x*sin(W*t) + y*cos(W*t)] }\nbodies: { ball: { mass: m, at: P } }\npotential: k*(x^2 + y^2)/2\n";
+    let model = load("turntable.yaml", turntable);
+    let lin = eomgen::linearize(model.as_ref(), &[0.0, 0.0], &[0.0, 0.0], 0.0);
+    match lin {
+        // The rotating frame's points depend on t; the speeds do not.
+        Ok(lin) => {
+            let g = (&lin.damping_matrix - lin.damping_matrix.transpose()) * 0.5;
+            assert!(
+                (g[(1, 0)].abs() - 2.0).abs() < 1e-14,
+                "{}",
+                lin.damping_matrix
+            );
+        }
+        Err(e) => panic!("{e}"),
+    }
 }

@@ -339,12 +339,14 @@ fn forcing_not_finite(
     if forcing.iter().any(|v| !v.is_finite()) {
         return Some(FailureCause::ForcingNotFinite { t, at_state: true });
     }
-    // Ahead along the motion: q + s q̇ (and q̇ unchanged, to first order as good as any).
+    // Ahead along the motion: q + s q̇ (and the second half unchanged, to first order as good
+    // as any); `q̇` from the kinematic equations in generalized speeds.
+    let rates = model.coordinate_rates(t, y);
     for exponent in [-9, -7, -5, -3] {
         let s = 10f64.powi(exponent);
         let mut ahead = y.to_vec();
         for i in 0..n {
-            ahead[i] += s * y[n + i];
+            ahead[i] += s * rates[i];
         }
         let (m, forcing) = model.mass_matrix_and_forcing(t + s, &ahead);
         if forcing.iter().chain(m.iter()).any(|v| !v.is_finite()) {

@@ -73,6 +73,8 @@ pub(crate) struct Rest {
     pub y: DMatrix<f64>,
     /// `P = ∂Z/∂q` (`n × n`).
     pub p: DMatrix<f64>,
+    /// The condition number `σ_max/σ_min` of `W`, by which `Y`'s rounding is larger than `ε`.
+    pub conditioning: f64,
 }
 
 /// The speeds at rest at `(q, t)` of a model in generalized speeds (see the module docs).
@@ -102,6 +104,7 @@ pub(crate) fn rest(model: &dyn ModelInfo, q: &[f64], t: f64) -> Result<Rest, Kin
     if singular_values.min() <= 1e-12 * singular_values.max() {
         return Err(singular());
     }
+    let conditioning = singular_values.max() / singular_values.min();
     let y = w.try_inverse().ok_or_else(singular)?;
     let u = -(&y * k0);
     state[n..].copy_from_slice(u.as_slice());
@@ -110,7 +113,12 @@ pub(crate) fn rest(model: &dyn ModelInfo, q: &[f64], t: f64) -> Result<Rest, Kin
     if !p.iter().all(|v| v.is_finite()) {
         return Err(singular());
     }
-    Ok(Rest { u, y, p })
+    Ok(Rest {
+        u,
+        y,
+        p,
+        conditioning,
+    })
 }
 
 /// The state at rest at `(q, t)`: `(q, 0)`, or in generalized speeds `(q, Z(q, t))`.
@@ -195,8 +203,20 @@ pub(crate) fn linearize_at_rest(
     let mass_matrix = &yt * &mass_u * &rest.y;
     // Symmetric in exact arithmetic; rounding of the products is averaged out.
     let mass_matrix = (&mass_matrix + mass_matrix.transpose()) * 0.5;
-    let damping_matrix = &yt * (&mass_u * &rest.p - &f_u * &rest.y);
-    let stiffness_matrix = &yt * (&mass_u * e - g - &f_u * &rest.p);
+    let mut damping_matrix = &yt * (&mass_u * &rest.p - &f_u * &rest.y);
+    let mut stiffness_matrix = &yt * (&mass_u * &e - &g - &f_u * &rest.p);
+    // The products' rounding, bounded entry by entry: `|fl(A B C) − A B C| ≤ γ |A| |B| |C|`
+    // with `γ` some `n ε` (Higham, *Accuracy and Stability of Numerical Algorithms*, 2nd ed.,
+    // §3.5), and `Y`'s own error `cond(W) ε |Y|`. A skew part of `C` or `K` within that bound
+    // is rounding of the products, not a gyroscopic or circulatory term (which the model in
+    // rates would show as such): it is averaged out.
+    let gamma = (4.0 * q.len() as f64 + rest.conditioning) * f64::EPSILON;
+    let (abs_y, abs_yt) = (rest.y.abs(), yt.abs());
+    let (abs_m, abs_fu, abs_p) = (mass_u.abs(), f_u.abs(), rest.p.abs());
+    let damping_bound = &abs_yt * (&abs_m * &abs_p + &abs_fu * &abs_y) * gamma;
+    let stiffness_bound = &abs_yt * (&abs_m * e.abs() + g.abs() + &abs_fu * &abs_p) * gamma;
+    average_rounding(&mut damping_matrix, &damping_bound);
+    average_rounding(&mut stiffness_matrix, &stiffness_bound);
     let finite = |m: &DMatrix<f64>| m.iter().all(|v| v.is_finite());
     if !(finite(&mass_matrix) && finite(&damping_matrix) && finite(&stiffness_matrix)) {
         return Err(failure(q, KinematicsFailure::NonFinite));
@@ -206,6 +226,21 @@ pub(crate) fn linearize_at_rest(
         damping: damping_matrix,
         stiffness: stiffness_matrix,
     })
+}
+
+/// Replaces each pair `(aᵢⱼ, aⱼᵢ)` of `a` by its mean where the two differ by no more than
+/// their rounding bounds `bound` (`n × n` each) allow.
+fn average_rounding(a: &mut DMatrix<f64>, bound: &DMatrix<f64>) {
+    let n = a.nrows();
+    for i in 0..n {
+        for j in i + 1..n {
+            if (a[(i, j)] - a[(j, i)]).abs() <= bound[(i, j)] + bound[(j, i)] {
+                let mean = 0.5 * (a[(i, j)] + a[(j, i)]);
+                a[(i, j)] = mean;
+                a[(j, i)] = mean;
+            }
+        }
+    }
 }
 
 fn failure(q: &[f64], kind: KinematicsFailure) -> KinematicsError {

@@ -236,9 +236,10 @@ fn guess(model: &dyn ModelInfo, items: &[String]) -> Result<Vec<f64>, CliError> 
         let d = model.description();
         let index = d.state_index(name).ok_or_else(|| {
             CliError::usage(format!(
-                "--guess {name}: `{}` has no coordinate or rate `{name}`; its coordinates are {} and their rates {}",
+                "--guess {name}: `{}` has no coordinate or rate `{name}`; its coordinates are {} and {} {}",
                 d.name,
                 coordinates.join(", "),
+                if d.has_speeds() { "its speeds" } else { "their rates" },
                 (n..2 * n).map(|i| d.state_name(i)).collect::<Vec<_>>().join(", ")
             ))
         })?;

@@ -215,10 +215,14 @@ fn shown_components(model: &dyn ModelInfo, names: Option<&str>) -> Result<Vec<us
     let outputs: Vec<&str> = (model.description().outputs.iter())
         .map(|o| &*o.name)
         .collect();
+    let speeds = match description.has_speeds() {
+        true => format!("; speeds: {}", description.speeds.join(", ")),
+        false => String::new(),
+    };
     let known = match outputs.is_empty() {
-        true => format!("coordinates: {}", coordinates.join(", ")),
+        true => format!("coordinates: {}{speeds}", coordinates.join(", ")),
         false => format!(
-            "coordinates: {}; outputs: {}",
+            "coordinates: {}{speeds}; outputs: {}",
             coordinates.join(", "),
             outputs.join(", ")
         ),
@@ -278,7 +282,10 @@ fn write_files(
     // it; a file of that name that eomgen did not write is kept, with a warning.
     if let Some(events) = events_csv {
         if solution.events.is_empty() {
-            files::remove_stale_or_warn(events, is_events_csv)?;
+            // The header this model writes, which names the speeds in generalized speeds.
+            let own = events_header(model);
+            let ours = |bytes: &[u8]| is_events_csv(bytes) || bytes.starts_with(own.as_bytes());
+            files::remove_stale_or_warn(events, ours)?;
         } else {
             write_events_csv(events, model, solution)?;
         }
@@ -639,10 +646,10 @@ fn print_events(model: &dyn ModelInfo, solution: &Solution) {
 /// The first columns of an events CSV's header ([`write_events_csv`]).
 const EVENTS_HEADER: &str = "event,direction,terminal,t";
 
-/// Whether `bytes` is an events CSV that eomgen wrote, for any model: its first line is the
-/// exact header [`write_events_csv`] writes, [`EVENTS_HEADER`] then the coordinates `c₁…cₙ`
-/// and their rates `c₁_dot…cₙ_dot` (or, in generalized speeds, `n` speeds, no coordinate's
-/// name among them).
+/// Whether `bytes` is an events CSV that eomgen wrote, for any model in the coordinates'
+/// rates: its first line is the exact header [`write_events_csv`] writes, [`EVENTS_HEADER`]
+/// then the coordinates `c₁…cₙ` and their rates `c₁_dot…cₙ_dot`. (A model in generalized
+/// speeds recognises its own header, [`events_header`].)
 fn is_events_csv(bytes: &[u8]) -> bool {
     let Some(line) = bytes.split(|&b| b == b'\n').next() else {
         return false;
@@ -655,13 +662,24 @@ fn is_events_csv(bytes: &[u8]) -> bool {
     };
     let columns: Vec<&str> = columns.split(',').collect();
     let (coordinates, rates) = columns.split_at(columns.len() / 2);
-    // The rates `c_dot` of the coordinates, or (generalized speeds) names of their own.
     columns.len().is_multiple_of(2)
-        && columns.iter().all(|c| !c.is_empty())
-        && (coordinates.iter().zip(rates)).all(|(c, r)| match r.strip_suffix("_dot") {
-            Some(rate) => rate == *c,
-            None => !coordinates.contains(r),
-        })
+        && coordinates
+            .iter()
+            .zip(rates)
+            .all(|(c, r)| !c.is_empty() && r.strip_suffix("_dot") == Some(c))
+}
+
+/// The first line of `model`'s events CSV: [`EVENTS_HEADER`], the coordinates, then the
+/// state's second half (the rates, or the speeds), and the line's end.
+fn events_header(model: &dyn ModelInfo) -> String {
+    let d = model.description();
+    let mut out = String::from(EVENTS_HEADER);
+    for i in 0..2 * d.num_dofs() {
+        out.push(',');
+        out.push_str(&d.state_name(i));
+    }
+    out.push('\n');
+    out
 }
 
 /// The located events as CSV: name, direction, t, coordinates, rates.
@@ -670,16 +688,7 @@ fn write_events_csv(
     model: &dyn ModelInfo,
     solution: &Solution,
 ) -> Result<(), CliError> {
-    let mut out = String::from(EVENTS_HEADER);
-    for c in model.description().coordinate_names() {
-        out.push_str(&format!(",{c}"));
-    }
-    let d = model.description();
-    for i in d.num_dofs()..2 * d.num_dofs() {
-        out.push(',');
-        out.push_str(&d.state_name(i));
-    }
-    out.push('\n');
+    let mut out = events_header(model);
     for e in &solution.events {
         out.push_str(&format!(
             "{},{},{},{:e}",
@@ -754,7 +763,6 @@ mod tests {
         for ours in [
             "event,direction,terminal,t,q,q_dot\n",
             "event,direction,terminal,t,x,theta,x_dot,theta_dot\nhit,rising,true,1e0,0,0,0,0\n",
-            "event,direction,terminal,t,phi,theta,w1,w2\n",
         ] {
             assert!(is_events_csv(ours.as_bytes()), "{ours}");
         }
@@ -766,7 +774,7 @@ mod tests {
             "event,direction,terminal,t,q,p_dot\n",
             "event,direction,terminal,time,q,q_dot\n",
             "event,direction,terminal,t,q,q_dot,extra\n",
-            "event,direction,terminal,t,phi,theta,w1,phi\n",
+            "event,direction,terminal,t,phi,theta,w1,w2\n",
             "# event,direction,terminal,t,q,q_dot\n",
         ] {
             assert!(!is_events_csv(theirs.as_bytes()), "{theirs}");

@@ -138,8 +138,12 @@ impl Exported<'_> {
         }
         let _ = writeln!(
             s,
-            "    return status;\n}}\n\n/* dy/dt = [qd; q''] ({two}) at (t, y): the status of {prefix}_accelerations. */\nint {prefix}_rhs(double t, const double *y, const double *p, double *ydot)\n{{\n    double x[{k}];\n    int i, status = {prefix}_accelerations(t, y, y + {n}, p, x);\n    if (status != 0) {{\n        return status;\n    }}\n{rates}    for (i = 0; i < {n}; ++i) {{\n{copy}        ydot[{n} + i] = x[i];\n    }}\n    return 0;\n}}",
+            "    return status;\n}}\n\n/* dy/dt = {what} ({two}) at (t, y): the status of {prefix}_accelerations. */\nint {prefix}_rhs(double t, const double *y, const double *p, double *ydot)\n{{\n    double x[{k}];\n    int i, status = {prefix}_accelerations(t, y, y + {n}, p, x);\n    if (status != 0) {{\n        return status;\n    }}\n{rates}    for (i = 0; i < {n}; ++i) {{\n{copy}        ydot[{n} + i] = x[i];\n    }}\n    return 0;\n}}",
             two = 2 * n,
+            what = match self.speeds.is_empty() {
+                true => "[qd; q'']",
+                false => "[q'; u'] (q' from coordinate_rates)",
+            },
             rates = match self.speeds.is_empty() {
                 true => String::new(),
                 false => format!("    {prefix}_coordinate_rates(t, y, y + {n}, p, ydot);\n"),

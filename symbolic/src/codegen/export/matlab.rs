@@ -120,13 +120,17 @@ impl Exported<'_> {
         let (n, m) = (self.n(), self.m());
         let _ = writeln!(
             s,
-            "function ydot = rhs(t, y, p)\n% dy/dt = [{rates}; q''] ({}).\nif nargin < 3 || isempty(p), p = parameters(); end\nq = y(1:{n});\nqd = y({}:{});\nx = accelerations(t, q, qd, p);\nydot = [{rates}; x(1:{n})];\nend\n",
+            "function ydot = rhs(t, y, p)\n% dy/dt = [{rates}; {second}] ({}).\nif nargin < 3 || isempty(p), p = parameters(); end\nq = y(1:{n});\nqd = y({}:{});\nx = accelerations(t, q, qd, p);\nydot = [{rates}; x(1:{n})];\nend\n",
             2 * n,
             n + 1,
             2 * n,
             rates = match self.speeds.is_empty() {
                 true => "qd",
                 false => "coordinate_rates(t, q, qd, p)",
+            },
+            second = match self.speeds.is_empty() {
+                true => "q''",
+                false => "u'",
             },
         );
         if m > 0 {

@@ -64,11 +64,17 @@ impl Exported<'_> {
         if m == 0 {
             let _ = writeln!(
                 s,
-                "\ndef rhs(t, y, p=PARAMETERS):\n    \"\"\"dy/dt = [{rates}; q''] ({}), q'' from M q'' = F.\"\"\"\n    y = np.asarray(y, dtype=float)\n    q, qd = y[:{n}], y[{n}:]\n    M, F = mass_matrix_and_forcing(t, q, qd, p)\n    return np.concatenate(({rates}, np.linalg.solve(M, F)))",
-                2 * n,
+                "\ndef rhs(t, y, p=PARAMETERS):\n    \"\"\"dy/dt = {what}.\"\"\"\n    y = np.asarray(y, dtype=float)\n    q, qd = y[:{n}], y[{n}:]\n    M, F = mass_matrix_and_forcing(t, q, qd, p)\n    return np.concatenate(({rates}, np.linalg.solve(M, F)))",
                 rates = match self.speeds.is_empty() {
                     true => "qd",
                     false => "coordinate_rates(t, q, qd, p)",
+                },
+                what = match self.speeds.is_empty() {
+                    true => format!("[qd; q''] ({}), q'' from M q'' = F", 2 * n),
+                    false => format!(
+                        "[q'; u'] ({}), q' from coordinate_rates, u' from M u' = F",
+                        2 * n
+                    ),
                 },
             );
         } else {

@@ -413,7 +413,10 @@ impl Checker<'_> {
                 continue;
             }
             let mut candidates: Vec<&str> = self.coords.clone();
-            candidates.extend(self.rates.iter().map(String::as_str));
+            match speeds {
+                true => candidates.extend(self.file.speeds.iter().map(|s| s.name.value.as_str())),
+                false => candidates.extend(self.rates.iter().map(String::as_str)),
+            }
             let d = Diagnostic::new(
                 k.location,
                 format!("`{n}` in `final_state` is neither a coordinate nor a rate"),
@@ -455,24 +458,31 @@ impl Checker<'_> {
     }
 
     /// With generalized speeds, an expression evaluated on the simulated state (an output, a
-    /// conserved quantity) reads the speeds, which the state holds, not the rates: a rate it
-    /// names is an error at its place.
+    /// conserved quantity) reads the speeds, which the state holds, not the rates: a rate, a
+    /// frame's angular velocity or a point's velocity it names is an error at its place.
     fn no_rates_beside_speeds(&mut self, e: &Expr, what: &str) {
         if self.file.speeds.is_empty() {
             return;
         }
         let mut ids = Vec::new();
         identifiers(e, &mut ids);
-        if let Some((rate, at)) = ids
-            .iter()
-            .find(|(n, _)| self.sets.rates.contains(n.as_str()))
-        {
+        // A rate by name, a frame's angular velocity (`omega_B_z`) or a point's velocity
+        // (`vel(P)`): each is a function of the rates once lowered.
+        let rate = ids.iter().find(|(n, _)| {
+            self.sets.rates.contains(n.as_str()) || self.file.angular_velocity_name(n).is_some()
+        });
+        let read = match rate {
+            Some((name, at)) => Some((format!("`{name}`"), *at)),
+            None => crate::model::vectors::uses_velocities(e)
+                .then(|| ("a point's velocity `vel(…)`".to_string(), e.location)),
+        };
+        if let Some((read, at)) = read {
             let speeds: Vec<&str> = (self.file.speeds.iter())
                 .map(|s| s.name.value.as_str())
                 .collect();
             self.error(
-                Diagnostic::new(*at, format!("{what} reads the rate `{rate}`, but a model in generalized speeds has the speeds in its state"))
-                    .with_help(format!("write it with the speeds ({}) and the coordinates", speeds.join(", "))),
+                Diagnostic::new(at, format!("{what} reads {read}, a function of the rates, but a model in generalized speeds has the speeds in its state"))
+                    .with_help(format!("write it with the speeds ({}), the coordinates and the parameters", speeds.join(", "))),
             );
         }
     }
