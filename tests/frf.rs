@@ -977,3 +977,26 @@ fn modes_gives_the_state_space_model_of_named_inputs_and_outputs() {
     let plain: serde_json::Value = serde_json::from_slice(&plain.stdout).unwrap();
     assert!(plain.get("state_space").is_none());
 }
+
+/// A load `A cos(w t)` beside a preload the spring balances: at the equilibrium `F ≈ 0`, and
+/// a quarter period on the load is rounding. The linearity test is against the load's own
+/// size, so `frf --input A` takes it whichever order the terms are written in, with
+/// `B = 1` (the unit force) and the static deflection `F3/k` as the equilibrium.
+#[test]
+fn a_load_beside_a_balanced_preload_is_linear_in_either_order() {
+    for force in [
+        "A*cos(w*t) + F3 - k*x - c*x_dot",
+        "F3 - k*x - c*x_dot + A*cos(w*t)",
+    ] {
+        let text = format!(
+            "name: preloaded\nparameters: {{ m: 1, k: 4, c: 0.3, A: 1.0, w: 0.8, F3: 1 }}\ncoordinates: [x]\npoints: {{ P: [x, 0] }}\nbodies: {{ ball: {{ mass: m, at: P }} }}\nforces: {{ spring: {{ at: P, vector: [{force}, 0] }} }}\n"
+        );
+        let jit = eomgen::JitModel::from_source("preloaded.yaml", &text).expect("loads");
+        let mut model = eomgen::DynFirstOrder::new(jit);
+        let forced = eomgen::linearize_with_input_rates(&mut model, &[0.0], &["A"], "w")
+            .unwrap_or_else(|e| panic!("{force}: {e}"));
+        assert_eq!(forced.input_matrix[(0, 0)], 1.0, "{force}");
+        assert_eq!(forced.input_rate_matrix[(0, 0)], 0.0, "{force}");
+        assert!((forced.equilibrium.q[0] - 0.25).abs() < 1e-15, "{force}");
+    }
+}

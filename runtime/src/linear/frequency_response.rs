@@ -531,8 +531,12 @@ fn input_rate_matrix(
         if !names.iter().any(|p| p == input) || input == frequency_parameter {
             continue;
         }
-        // The generalized force per unit input at time `t` with the frequency set to `w`.
-        let mut load = |w: f64, t: f64| -> Result<DVector<f64>, FrfError> {
+        // The generalized force per unit input at time `t` with the frequency set to `w`. The
+        // linearity test is against the larger of `max |F|` there and `floor` (the load's
+        // size at t = 0): a quarter period on, a load `A cos(w t)` is rounding beside an
+        // equilibrium where `F ≈ 0`, and `max |F|` alone would make that rounding look like
+        // nonlinearity.
+        let mut load = |w: f64, t: f64, floor: f64| -> Result<DVector<f64>, FrfError> {
             model.set_parameter(frequency_parameter, w)?;
             let mut f = Vec::with_capacity(3);
             for p in [0.0, 1.0, 2.0] {
@@ -541,7 +545,7 @@ fn input_rate_matrix(
             }
             model.set_parameter(input, 0.0)?;
             let d1 = &f[1] - &f[0];
-            let scale = f.iter().fold(0.0f64, |a, v| a.max(v.amax()));
+            let scale = f.iter().fold(floor, |a, v| a.max(v.amax()));
             let deviation = (&(&f[2] - &f[1]) - &d1).amax();
             if deviation.is_nan() || deviation > LINEARITY_TOLERANCE * scale {
                 return Err(FrfError::NonlinearInput {
@@ -556,9 +560,10 @@ fn input_rate_matrix(
             Ok(d1)
         };
         let quarter = std::f64::consts::FRAC_PI_2 / w;
-        let start = load(w, 0.0)?;
-        let half = load(w, 2.0 * quarter)?;
-        let at_quarter = load(w, quarter)?;
+        let start = load(w, 0.0, 0.0)?;
+        let floor = start.amax();
+        let half = load(w, 2.0 * quarter, floor)?;
+        let at_quarter = load(w, quarter, floor)?;
         let scale = start.amax().max(half.amax()).max(at_quarter.amax());
         // Only a load that reverses over half a period (`cos(w t)` and its rate) has a rate
         // column; a constant load, or one that `w` does not time, keeps `B₁ = 0`.
@@ -568,7 +573,7 @@ fn input_rate_matrix(
         }
         let b1 = -at_quarter / w;
         let other = 1.5 * w;
-        let b1_other = -load(other, std::f64::consts::FRAC_PI_2 / other)? / other;
+        let b1_other = -load(other, std::f64::consts::FRAC_PI_2 / other, floor)? / other;
         let deviation = (&b1_other - &b1).amax() / b1.amax();
         if deviation.is_nan() || deviation > RATE_CONSTANCY_TOLERANCE {
             return Err(FrfError::InputRateNotConstant {
