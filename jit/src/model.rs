@@ -4,6 +4,7 @@ use std::borrow::Cow;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex, OnceLock};
 
+use eomgen_runtime::dynamic::{rates_are_the_state, rates_are_the_state_jacobian};
 use eomgen_runtime::taylor::{
     DerivedLists, MotionLayout, MotionSolve, TaylorFunctions, TaylorProgram, TaylorUnsupported,
     UNROLLED_CAPACITY,
@@ -600,9 +601,7 @@ impl DynMechanicalSystem for JitModel {
     }
     fn coordinate_rates(&self, q: &[f64], qdot: &[f64], t: f64, out: &mut [f64]) {
         if !self.code.program.description.has_speeds() {
-            let n = self.num_dofs();
-            out[..n].copy_from_slice(&qdot[..n]);
-            return;
+            return rates_are_the_state(self.num_dofs(), qdot, out);
         }
         self.run(
             Routine::CoordinateRates,
@@ -619,12 +618,8 @@ impl DynMechanicalSystem for JitModel {
         d_q: &mut [f64],
         d_u: &mut [f64],
     ) {
-        let n = self.num_dofs();
         if !self.code.program.description.has_speeds() {
-            d_q[..n * n].fill(0.0);
-            d_u[..n * n].fill(0.0);
-            (0..n).for_each(|i| d_u[i + i * n] = 1.0);
-            return;
+            return rates_are_the_state_jacobian(self.num_dofs(), d_q, d_u);
         }
         // Every entry is written: a zero entry is a constant of the tape.
         self.run(

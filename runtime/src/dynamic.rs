@@ -136,8 +136,7 @@ pub trait DynMechanicalSystem {
     /// copies `qdot` (a model in the coordinates' rates).
     fn coordinate_rates(&self, q: &[f64], qdot: &[f64], t: f64, out: &mut [f64]) {
         let _ = (q, t);
-        let n = self.num_dofs();
-        out[..n].copy_from_slice(&qdot[..n]);
+        rates_are_the_state(self.num_dofs(), qdot, out);
     }
     /// [`MechanicalSystem::coordinate_rates_jacobian`]: `∂q̇/∂q` into `d_q` and `∂q̇/∂u`
     /// into `d_u` (`n × n`, column-major each); the default writes `0` and `I`.
@@ -150,12 +149,7 @@ pub trait DynMechanicalSystem {
         d_u: &mut [f64],
     ) {
         let _ = (q, qdot, t);
-        let n = self.num_dofs();
-        d_q[..n * n].fill(0.0);
-        d_u[..n * n].fill(0.0);
-        for i in 0..n {
-            d_u[i + i * n] = 1.0;
-        }
+        rates_are_the_state_jacobian(self.num_dofs(), d_q, d_u);
     }
 
     /// [`MechanicalSystem::taylor`].
@@ -164,6 +158,23 @@ pub trait DynMechanicalSystem {
     /// [`TaylorUnsupported`] naming what is missing.
     fn taylor(&self) -> Result<&dyn TaylorFunctions, TaylorUnsupported> {
         Err(TaylorUnsupported::NotGenerated)
+    }
+}
+
+/// The coordinates' rates of a model in the rates (no generalized speeds): the state's second
+/// half `qdot` itself, its first `n` entries into `out`. The default of
+/// [`DynMechanicalSystem::coordinate_rates`], for an implementation that has both kinds.
+pub fn rates_are_the_state(n: usize, qdot: &[f64], out: &mut [f64]) {
+    out[..n].copy_from_slice(&qdot[..n]);
+}
+
+/// The Jacobians of [`rates_are_the_state`]: `0` into `d_q` and `I` into `d_u` (`n × n`,
+/// column-major each). The default of [`DynMechanicalSystem::coordinate_rates_jacobian`].
+pub fn rates_are_the_state_jacobian(n: usize, d_q: &mut [f64], d_u: &mut [f64]) {
+    d_q[..n * n].fill(0.0);
+    d_u[..n * n].fill(0.0);
+    for i in 0..n {
+        d_u[i + i * n] = 1.0;
     }
 }
 

@@ -73,6 +73,8 @@ pub(crate) struct Rest {
     pub y: DMatrix<f64>,
     /// `P = ∂Z/∂q` (`n × n`).
     pub p: DMatrix<f64>,
+    /// `K_q = ∂q̇/∂q` at `(q, Z)` (`n × n`), of which `P = −Y K_q`.
+    pub rates_q: DMatrix<f64>,
     /// The condition number `σ_max/σ_min` of `W`, by which `Y`'s rounding is larger than `ε`.
     pub conditioning: f64,
 }
@@ -108,8 +110,8 @@ pub(crate) fn rest(model: &dyn ModelInfo, q: &[f64], t: f64) -> Result<Rest, Kin
     let y = w.try_inverse().ok_or_else(singular)?;
     let u = -(&y * k0);
     state[n..].copy_from_slice(u.as_slice());
-    let (k_q, _) = model.coordinate_rates_jacobian(t, &state);
-    let p = -(&y * k_q);
+    let (rates_q, _) = model.coordinate_rates_jacobian(t, &state);
+    let p = -(&y * &rates_q);
     if !p.iter().all(|v| v.is_finite()) {
         return Err(singular());
     }
@@ -117,6 +119,7 @@ pub(crate) fn rest(model: &dyn ModelInfo, q: &[f64], t: f64) -> Result<Rest, Kin
         u,
         y,
         p,
+        rates_q,
         conditioning,
     })
 }
@@ -197,8 +200,7 @@ pub(crate) fn linearize_at_rest(
     let g = f_q - model.mass_matrix_product_jacobian(t, &state, a.as_slice());
     let shifted: Vec<f64> = q.iter().chain((&rest.u + &a).iter()).copied().collect();
     let (k_shifted, _) = model.coordinate_rates_jacobian(t, &shifted);
-    let (k_rest, _) = model.coordinate_rates_jacobian(t, &state);
-    let e = -(&rest.y * (k_shifted - k_rest));
+    let e = -(&rest.y * (k_shifted - &rest.rates_q));
     let yt = rest.y.transpose();
     let mass_matrix = &yt * &mass_u * &rest.y;
     // Symmetric in exact arithmetic; rounding of the products is averaged out.
