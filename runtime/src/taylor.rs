@@ -47,12 +47,12 @@ fn series(s: &[f64], capacity: usize, slot: Slot) -> &[f64] {
     &s[start..start + capacity]
 }
 
-/// `$m!($($arg)*; 1 2 … 23)`: the orders compiled with `k` known ([`UNROLLED_ORDERS`]), one
+/// `$m!($($arg)*; 1 2 … 19)`: the orders compiled with `k` known ([`UNROLLED_ORDERS`]), one
 /// list for every dispatch on the order.
 macro_rules! unrolled_orders {
     ($m:ident $(, $arg:tt)*) => {{
-        const _: () = assert!(UNROLLED_ORDERS == 23);
-        $m!($($arg)*; 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23)
+        const _: () = assert!(UNROLLED_ORDERS == 19);
+        $m!($($arg)*; 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19)
     }};
 }
 
@@ -1066,7 +1066,7 @@ fn accelerations(
     s: &mut [f64],
     out: &mut [f64],
 ) {
-    /// One variant, out of line (the dispatch would otherwise inline 6 × 24 of them).
+    /// One variant, out of line (the dispatch would otherwise inline 7 × 20 of them).
     #[inline(never)]
     fn variant<const N: usize, const K: usize>(
         layout: &MotionLayout<'_>,
