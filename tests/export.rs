@@ -161,8 +161,9 @@ fn array(values: &[f64]) -> String {
     format!("{{{}}}", items.join(", "))
 }
 
-/// The files exported: every bundled model and the two fixtures in generalized speeds (whose
-/// `qd` is `u` and whose `rhs` takes `q̇` from `coordinate_rates`), as `(name, file, text)`.
+/// The files exported: every bundled model and three fixtures in generalized speeds (whose
+/// `qd` is `u` and whose `rhs` takes `q̇` from `coordinate_rates`; the rolling disc's with its
+/// auxiliary speeds held by `J = [0 I]`), as `(name, file, text)`.
 fn exported_files() -> Vec<(String, String, String)> {
     let bundled = eomgen::models::ALL.iter().map(|entry| {
         (
@@ -171,7 +172,12 @@ fn exported_files() -> Vec<(String, String, String)> {
             entry.source().to_string(),
         )
     });
-    let fixtures = ["free_rigid_body_speeds", "heavy_top_speeds"].map(|name| {
+    let fixtures = [
+        "free_rigid_body_speeds",
+        "heavy_top_speeds",
+        "rolling_disc_speeds",
+    ]
+    .map(|name| {
         let file = format!("{}/tests/fixtures/{name}.yaml", env!("CARGO_MANIFEST_DIR"));
         let text = std::fs::read_to_string(&file).unwrap();
         (name.to_string(), file, text)

@@ -501,3 +501,67 @@ fn rounding_of_the_speeds_is_not_a_coupling() {
         lin.damping_matrix
     );
 }
+
+/// Kane's way for a non-holonomic system: the rolling disc in its body rates (three speeds
+/// for five coordinates, the rolling contact's two rows its auxiliary speeds held at 0)
+/// against the bundled disc in the rates with Lagrange's multipliers, from the same state
+/// (the rates from the kinematic equations), with DOP853 at rtol 1e-12 over 2 s: the
+/// coordinates agree to 1e-8 and the contact forces (the multipliers, the same rows in both)
+/// to 1e-7 relative, with the auxiliary speeds held to rounding. Also with Radau IIA through
+/// the exact Jacobian.
+#[test]
+fn a_rolling_disc_in_speeds_moves_as_with_multipliers_in_the_rates() {
+    let options = |method, initial_state| SimulationOptions {
+        method,
+        t_end: 2.0,
+        rtol: 1e-12,
+        atol: 1e-12,
+        output: OutputTimes::At(vec![2.0]),
+        initial_state,
+        ..SimulationOptions::default()
+    };
+    let text = std::fs::read_to_string(fixture("rolling_disc_speeds.yaml")).expect("fixture");
+    let disc = load("rolling_disc_speeds.yaml", &text);
+    let speeds: Vec<&str> = disc
+        .description()
+        .speeds
+        .iter()
+        .map(|s| s.as_ref())
+        .collect();
+    assert_eq!(speeds, ["w1", "w2", "w3", "roll_x", "roll_y"]);
+    let y0 = disc.initial_state();
+    let rates = disc.coordinate_rates(0.0, &y0);
+    let start: Vec<f64> = y0[..5].iter().chain(rates.iter()).copied().collect();
+    // The fixture's start is a lean of 0.1 with no slip: x' = r (w2 − w3 tan(lean)).
+    let expected = 0.2 * (10.0 - 0.5 * 0.1f64.tan());
+    assert!((start[5] - expected).abs() < 1e-14, "x' = {}", start[5]);
+    let mut reference = (eomgen::models::find("rolling_disc").expect("bundled").make)();
+    let run =
+        simulate(reference.as_mut(), &options(Method::Dop853, Some(start))).expect("reference run");
+    let (_, y_ref) = run.solution.last().expect("a sample");
+    let forces_ref = reference.constraint_forces(2.0, y_ref).expect("forces");
+    for method in [Method::Dop853, Method::Radau5] {
+        let mut disc = load("rolling_disc_speeds.yaml", &text);
+        let run = simulate(disc.as_mut(), &options(method, None)).expect("run in speeds");
+        let (_, y) = run.solution.last().expect("a sample");
+        for i in 0..5 {
+            assert!(
+                (y[i] - y_ref[i]).abs() < 1e-8,
+                "{method:?}: q[{i}] {} vs {}",
+                y[i],
+                y_ref[i]
+            );
+        }
+        assert!(
+            y[8].abs() < 1e-12 && y[9].abs() < 1e-12,
+            "auxiliary speeds {y:?}"
+        );
+        let forces = disc.constraint_forces(2.0, y).expect("forces");
+        for (a, b) in forces.iter().zip(&forces_ref) {
+            assert!(
+                (a - b).abs() < 1e-7 * b.abs().max(1.0),
+                "{method:?}: λ {forces:?} vs {forces_ref:?}"
+            );
+        }
+    }
+}

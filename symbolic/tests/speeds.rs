@@ -342,8 +342,32 @@ fn mistaken_speeds_are_located() {
     );
     let e = load_error(&quaternion);
     assert!(
-        e.contains("generalized speeds are not supported in a model with constraints"),
+        e.contains("generalized speeds are not supported in a model with holonomic constraints"),
         "{e}"
+    );
+    // Beside non-holonomic constraints, one speed per degree of freedom: a point on a line
+    // `y' = x'` has one.
+    let sliding = |speeds: &str| {
+        planar(speeds, "x: 1").replace("points:", "nonholonomic: { along: y_dot - x_dot }\npoints:")
+    };
+    let e = load_error(&sliding("a: x_dot, b: y_dot"));
+    assert!(
+        e.contains("3:11: the model has 2 coordinates and 1 non-holonomic constraint row but 2 speeds: `speeds` gives one per degree of freedom, 1"),
+        "{e}"
+    );
+    let e = lowering_error(&sliding("a: x_dot - y_dot"));
+    assert!(
+        e.starts_with("3:11: the speeds do not determine the rates"),
+        "{e}"
+    );
+    let model = SymbolicModel::from_file(
+        &eomgen_symbolic::model::load("m.yaml", &sliding("a: x_dot")).expect("loads"),
+    )
+    .expect("derives");
+    let speeds = model.speeds.as_ref().expect("in speeds");
+    assert_eq!(
+        (speeds.names.as_slice(), speeds.auxiliary),
+        (["a".to_string(), "along".to_string()].as_slice(), 1)
     );
     let file = eomgen_symbolic::model::load("m.yaml", FREE_BODY).expect("loads");
     let exported = eomgen_symbolic::codegen::export::export(

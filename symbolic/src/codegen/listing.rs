@@ -253,10 +253,17 @@ pub fn equations_text(model: &SymbolicModel, eom: &EquationsOfMotion) -> String 
         let names: Vec<&str> = e.constraints.iter().map(|c| c.name.as_str()).collect();
         let _ = writeln!(
             s,
-            "M q'' + J^T lambda = F and J q'' = gamma, lambda = [{}] (the constraint forces), with",
+            "M {rate} + J^T lambda = F and J {rate} = gamma, lambda = [{}] (the constraint forces), with",
             names.join(", ")
         );
     }
+    // With speeds, `J`'s columns are the speeds'; a non-holonomic row is then its auxiliary
+    // speed, held at 0 (Kane's equations of the independent speeds are the rows above at 0).
+    let columns = if e.speeds.is_empty() {
+        &e.coordinates
+    } else {
+        &e.speeds
+    };
     for (i, row) in e.mass_matrix.iter().enumerate() {
         for (j, m) in row.iter().enumerate().skip(i) {
             let _ = writeln!(s, "  M[{i},{j}] = {m}");
@@ -268,7 +275,7 @@ pub fn equations_text(model: &SymbolicModel, eom: &EquationsOfMotion) -> String 
     for c in &e.constraints {
         for (j, entry) in c.jacobian.iter().enumerate() {
             if entry != "0" {
-                let _ = writeln!(s, "  J[{},{}] = {entry}", c.name, e.coordinates[j]);
+                let _ = writeln!(s, "  J[{},{}] = {entry}", c.name, columns[j]);
             }
         }
         let _ = writeln!(s, "  gamma[{}] = {}", c.name, c.gamma);
@@ -278,6 +285,9 @@ pub fn equations_text(model: &SymbolicModel, eom: &EquationsOfMotion) -> String 
         for c in &e.constraints {
             let what = match c.kind {
                 ConstraintKind::Holonomic => "holonomic: Phi(q, t) = 0",
+                ConstraintKind::Nonholonomic if !e.speeds.is_empty() => {
+                    "non-holonomic: its auxiliary speed A q' + b, held at 0"
+                }
                 ConstraintKind::Nonholonomic => "non-holonomic: A q' + b = 0",
             };
             let _ = writeln!(s, "  {}: {} = 0 ({what})", c.name, c.equation);

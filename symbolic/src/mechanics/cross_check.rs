@@ -878,12 +878,26 @@ fn integrable_nonholonomic(model: &mut SymbolicModel, seed: u64) -> Vec<String> 
     let mut variables: Vec<crate::expr::SymbolId> = symbols.iter().map(|s| s[0]).collect();
     variables.push(ts);
     let mut found = Vec::new();
+    // In speeds, a constraint's row is its auxiliary speed's: `A` and `b` are that speed's
+    // coefficients and offset (the constraint itself reads `u = 0`).
+    let speeds = model.speeds.clone();
     for r in c.holonomic..c.len() {
         let arena = &mut model.arena;
         let zero = arena.int(0);
         let at_rest: FxHashMap<_, _> = symbols.iter().map(|s| (s[1], zero)).collect();
-        let mut coefficients: Vec<ExprId> = (0..n).map(|j| c.jacobian[r * n + j]).collect();
-        coefficients.push(arena.substitute(c.velocity[r], &at_rest));
+        let coefficients: Vec<ExprId> = match &speeds {
+            Some(sp) => {
+                let row = n - c.len() + r;
+                let mut a = sp.coefficients[row * n..(row + 1) * n].to_vec();
+                a.push(sp.offsets[row]);
+                a
+            }
+            None => {
+                let mut a: Vec<ExprId> = (0..n).map(|j| c.jacobian[r * n + j]).collect();
+                a.push(arena.substitute(c.velocity[r], &at_rest));
+                a
+            }
+        };
         let k = coefficients.len();
         if k < 3 {
             found.push(c.names[r].clone());

@@ -124,10 +124,17 @@ pub enum BalanceInfo {
 /// used by `super::speeds`).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Speeds {
-    /// The speeds' names, in file order (one per coordinate).
+    /// The speeds' names, one per coordinate: the file's, in file order, then the
+    /// non-holonomic constraint rows' (their auxiliary speeds, held at 0 by the constraints).
     pub names: Vec<String>,
+    /// How many of [`Self::names`] are the non-holonomic constraint rows' auxiliary speeds
+    /// (the last ones): `uᵣ = A q̇ + b` of its row, held at 0 by its multiplier.
+    pub auxiliary: usize,
     /// The kinematic equations: `q̇ⱼ` as an expression of `q`, `u` and `t`, per coordinate.
     pub kinematic_equations: Vec<ExprId>,
+    /// `Y`, `n × n` row-major: `u = Y q̇ + Z` (the auxiliary speeds' rows are the
+    /// constraints' `A`).
+    pub coefficients: Vec<ExprId>,
     /// `W = Y⁻¹`, `n × n` row-major: `q̇ = W (u − Z)`.
     pub inverse: Vec<ExprId>,
     /// `Z(q, t)`, per speed: its value with every rate 0.

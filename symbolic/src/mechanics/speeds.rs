@@ -99,6 +99,20 @@ pub(crate) fn switch(
     file: &ModelFile,
 ) -> Result<SymbolicModel, Vec<Diagnostic>> {
     let n = model.num_dofs();
+    // Each non-holonomic constraint row `A q̇ + b` is an auxiliary speed held at 0 (Kane &
+    // Levinson §§2.13, 4.4): with the file's speeds it determines the rates, and its
+    // constraint becomes `uᵣ = 0` (see [`auxiliary_constraints`]).
+    let holonomic = model.constraints.holonomic;
+    let auxiliary: Vec<(String, ExprId)> = (model.constraints.names.iter().cloned())
+        .zip(model.constraints.velocity.iter().copied())
+        .skip(holonomic)
+        .collect();
+    let definitions: Vec<ExprId> = (definitions.iter().copied())
+        .chain(auxiliary.iter().map(|(_, g)| *g))
+        .collect();
+    let names: Vec<String> = (file.speeds.iter().map(|s| s.name.value.clone()))
+        .chain(auxiliary.iter().map(|(name, _)| name.clone()))
+        .collect();
     if n > MAX_SPEEDS {
         let first = &file.speeds[0];
         return Err(vec![
@@ -138,8 +152,8 @@ pub(crate) fn switch(
         // rest that still reads the rates must then vanish at random states too.
         let nonlinear = row.iter().any(|&c| rates_in(arena, c))
             || (rates_in(arena, rest) && !vanishes(arena, &model.parameters, rest, d));
-        if nonlinear {
-            let speed = &file.speeds[r];
+        // (A constraint row's linearity was checked where it was lowered.)
+        if let (true, Some(speed)) = (nonlinear, file.speeds.get(r)) {
             errors.push(
                 Diagnostic::new(speed.value.location, format!("speed `{}` is not linear in the rates", speed.name.value))
                     .with_help("a generalized speed is a combination of the rates with coefficients in the coordinates and `t`, such as `omega_B_x` or `theta1_dot + theta2_dot`"),
@@ -156,7 +170,7 @@ pub(crate) fn switch(
         let first = &file.speeds[0];
         return Err(vec![
             Diagnostic::new(first.name.location, "the speeds do not determine the rates: the determinant of their coefficients in the rates is identically 0")
-                .with_help("choose speeds that are independent combinations of the rates, one per coordinate"),
+                .with_help("choose speeds that are independent combinations of the rates, one per degree of freedom, and independent of the non-holonomic constraints"),
         ]);
     }
     let inverse: Vec<ExprId> = adjugate
@@ -165,28 +179,31 @@ pub(crate) fn switch(
         .collect();
 
     // The model checks keep each speed's name and its `_dot` apart from every other name.
-    if let Some(taken) = (file.speeds.iter()).find(|sp| {
-        let name = &sp.name.value;
+    let taken = |name: &str| {
         arena.symbol_id(name).is_some() || arena.symbol_id(&format!("{name}_dot")).is_some()
-    }) {
+    };
+    if let Some(r) = names.iter().position(|name| taken(name)) {
+        let name = &names[r];
+        let (what, location, help) = match file.speeds.get(r) {
+            Some(speed) => ("speed name", speed.name.location, "rename the speed"),
+            None => (
+                "non-holonomic constraint row",
+                (file.nonholonomic_names().iter())
+                    .find(|k| k.value == *name)
+                    .map(|k| k.location)
+                    .unwrap_or(file.speeds[0].name.location),
+                "rename the constraint: with `speeds`, each row of a non-holonomic constraint is an auxiliary speed of its name",
+            ),
+        };
         return Err(vec![
             Diagnostic::new(
-                taken.name.location,
-                format!(
-                    "speed name `{}` (or its rate `{}_dot`) is taken by another name of the model",
-                    taken.name.value, taken.name.value
-                ),
+                location,
+                format!("{what} `{name}` (or its rate `{name}_dot`) is taken by another name of the model"),
             )
-            .with_help("rename the speed"),
+            .with_help(help),
         ]);
     }
-    let pairs = arena.switch_to_speeds(
-        &file
-            .speeds
-            .iter()
-            .map(|s| s.name.value.clone())
-            .collect::<Vec<_>>(),
-    );
+    let pairs = arena.switch_to_speeds(&names);
     let u: Vec<ExprId> = pairs.iter().map(|[u, _]| *u).collect();
     for (c, new) in model.coordinates.iter_mut().zip(&pairs) {
         c[1] = new[0];
@@ -208,7 +225,9 @@ pub(crate) fn switch(
     arena.set_coordinate_rates(rates.clone());
     let accelerations: Vec<ExprId> = rates.iter().map(|&r| arena.time_derivative(r)).collect();
     let speeds = Speeds {
-        names: file.speeds.iter().map(|s| s.name.value.clone()).collect(),
+        names,
+        auxiliary: auxiliary.len(),
+        coefficients: y,
         kinematic_equations: rates,
         inverse,
         offsets,
@@ -276,7 +295,11 @@ pub(crate) fn switch(
         .collect();
 
     model.initial_qdot = match initial {
-        Some(u0) => u0,
+        // The auxiliary speeds start at 0, on their constraints.
+        Some(mut u0) => {
+            u0.resize(n, zero);
+            u0
+        }
         None => {
             let mut start: FxHashMap<SymbolId, ExprId> = FxHashMap::default();
             for (j, s) in old.iter().enumerate() {
@@ -290,12 +313,42 @@ pub(crate) fn switch(
         }
     };
     let lagrange = speeds.carried(arena, &lagrange_mass, &lagrange_forcing, &accelerations);
+    if !auxiliary.is_empty() {
+        model.constraints = auxiliary_constraints(arena, &model.constraints, &u);
+    }
     model.speeds = Some(Speeds {
         lagrange: (lagrange.mass_matrix, lagrange.forcing),
         ..speeds
     });
     super::finish_derivation(&mut model, file)?;
     Ok(model)
+}
+
+/// The non-holonomic constraints in the speeds: row `i` (of `m`, after the `holonomic`
+/// rows, of which there are none beside speeds) is `u_{n−m+i} = 0`, its auxiliary speed, so
+/// `J = [0 I]`, the velocity residual is that speed and `γ = 0`. The multipliers are the
+/// constraint forces as in the rates: `Q = Aᵀλ` on the coordinates is `W̄ᵀAᵀλ = [0; λ]` on
+/// the speeds, since `A W̄ = [0 I]`.
+fn auxiliary_constraints(
+    arena: &mut ExprArena,
+    constraints: &super::ConstraintEquations,
+    u: &[ExprId],
+) -> super::ConstraintEquations {
+    let (n, m) = (u.len(), constraints.len());
+    debug_assert_eq!(constraints.holonomic, 0, "refused by the model's rules");
+    let (zero, one) = (arena.int(0), arena.int(1));
+    let mut jacobian = vec![zero; m * n];
+    for i in 0..m {
+        jacobian[i * n + n - m + i] = one;
+    }
+    super::ConstraintEquations {
+        names: constraints.names.clone(),
+        holonomic: 0,
+        phi: Vec::new(),
+        jacobian,
+        velocity: u[n - m..].to_vec(),
+        gamma: vec![zero; m],
+    }
 }
 
 impl Speeds {

@@ -65,12 +65,13 @@ impl Checker<'_> {
         }
     }
 
-    // Rule (`speeds:`): one generalized speed per coordinate, each read where the rates may
-    // be, defined by the rates (not other speeds) and not named as an angular velocity, in a
-    // model of the kinematic form; `initial:` gives the speeds or the rates, not both. The equations in speeds are
-    // derived for holonomic systems without contacts (Kane and Levinson, ch. 6, for the
-    // rest: constraints, contacts, balances and hand-written equations in speeds are not
-    // supported).
+    // Rule (`speeds:`): one generalized speed per degree of freedom (per coordinate, less one
+    // per non-holonomic constraint row), each read where the rates may be, defined by the
+    // rates (not other speeds) and not named as an angular velocity, in a model of the
+    // kinematic form; `initial:` gives the speeds or the rates, not both. The equations in
+    // speeds are derived for systems without holonomic constraints or contacts (Kane and
+    // Levinson, ch. 6: holonomic constraints, contacts, balances and hand-written equations
+    // in speeds are not supported).
     pub(super) fn speeds(&mut self) {
         let file = self.file;
         let Some(first) = file.speeds.first() else {
@@ -98,11 +99,30 @@ impl Checker<'_> {
                 );
             }
         }
+        // One speed per degree of freedom: per coordinate, less one per non-holonomic
+        // constraint row (those rows become the auxiliary speeds held at 0).
         let (n, p) = (file.coordinates.len(), file.speeds.len());
-        if n != p && !self.incomplete.has_section("coordinates") {
+        let rows = file.nonholonomic_names().len();
+        let plural = |k: usize| if k == 1 { "" } else { "s" };
+        if n != p + rows && !self.incomplete.has_section("coordinates") {
+            let message = if rows == 0 {
+                format!(
+                    "the model has {n} coordinate{} but {p} speed{}: `speeds` gives one per coordinate",
+                    plural(n),
+                    plural(p)
+                )
+            } else {
+                format!(
+                    "the model has {n} coordinate{} and {rows} non-holonomic constraint row{} but {p} speed{}: `speeds` gives one per degree of freedom, {}",
+                    plural(n),
+                    plural(rows),
+                    plural(p),
+                    n.saturating_sub(rows)
+                )
+            };
             self.error(
-                Diagnostic::new(first.name.location, format!("the model has {n} coordinate{} but {p} speed{}: `speeds` gives one per coordinate", if n == 1 { "" } else { "s" }, if p == 1 { "" } else { "s" }))
-                    .with_help("each speed is a combination of the rates, such as `w1: omega_B_x`; together they must determine every rate"),
+                Diagnostic::new(first.name.location, message)
+                    .with_help("each speed is a combination of the rates, such as `w1: omega_B_x`; together with the non-holonomic constraints they must determine every rate"),
             );
         }
         if file.kinetic.is_some()
@@ -115,12 +135,8 @@ impl Checker<'_> {
         }
         let unsupported = [
             (
-                !file.constraint_names().is_empty(),
-                "constraints (including a frame's Euler parameters)",
-            ),
-            (
-                !file.nonholonomic_names().is_empty(),
-                "non-holonomic constraints",
+                !file.holonomic_names().is_empty(),
+                "holonomic constraints (including a frame's Euler parameters)",
             ),
             (!file.contacts.is_empty(), "contacts"),
             (!file.balances.is_empty(), "balances"),
