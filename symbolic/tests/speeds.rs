@@ -355,6 +355,13 @@ fn mistaken_speeds_are_located() {
         e.contains("3:11: the model has 2 coordinates and 1 non-holonomic constraint row but 2 speeds: `speeds` gives one per degree of freedom, 1"),
         "{e}"
     );
+    let e = load_error(&sliding("along: x_dot"));
+    assert!(
+        e.contains(
+            "3:11: speed name `along` is taken: it names a row of a non-holonomic constraint"
+        ),
+        "{e}"
+    );
     let e = lowering_error(&sliding("a: x_dot - y_dot"));
     assert!(
         e.starts_with("3:11: the speeds do not determine the rates"),

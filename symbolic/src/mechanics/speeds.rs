@@ -28,6 +28,13 @@
 //!
 //! and Lagrange's equations `M_q q̈ = F_q` (derived before the switch) carry into
 //! `Wᵀ M_q W u̇ = Wᵀ (F_q − M_q Ẇ (u − Z) − M_q W Ż)`, which the checks compare.
+//!
+//! Beside `m` non-holonomic constraints `A q̇ + b = 0` the file gives `n − m` speeds, and each
+//! constraint row is an auxiliary speed `A q̇ + b` of its name (§§2.13, 4.4), the last rows of
+//! `Y`, held at 0 by the constraint `u = 0` (`J = [0 I]`, `γ = 0`). The constraint forces
+//! `Aᵀλ` on the coordinates are `[0; λ]` on the speeds (`A W = [0 I]`): Kane's rows of the
+//! independent speeds at the auxiliary speeds 0 are the non-holonomic equations, and the
+//! auxiliary rows give the multipliers, as in the rates.
 
 use rustc_hash::FxHashMap;
 
@@ -182,7 +189,9 @@ pub(crate) fn switch(
     let taken = |name: &str| {
         arena.symbol_id(name).is_some() || arena.symbol_id(&format!("{name}_dot")).is_some()
     };
-    if let Some(r) = names.iter().position(|name| taken(name)) {
+    // (A speed named as a constraint row is the model checks' error; refused here too.)
+    let repeated = |r: usize| names[..r].contains(&names[r]);
+    if let Some(r) = (0..names.len()).find(|&r| taken(&names[r]) || repeated(r)) {
         let name = &names[r];
         let (what, location, help) = match file.speeds.get(r) {
             Some(speed) => ("speed name", speed.name.location, "rename the speed"),

@@ -77,8 +77,16 @@ impl Checker<'_> {
         let Some(first) = file.speeds.first() else {
             return;
         };
+        let rows = file.nonholonomic_names();
         for s in &file.speeds {
             s.rules(self);
+            // A non-holonomic constraint row is an auxiliary speed of its own name.
+            if rows.iter().any(|r| r.value == s.name.value) {
+                self.error(
+                    Diagnostic::new(s.name.location, format!("speed name `{}` is taken: it names a row of a non-holonomic constraint, whose auxiliary speed it is", s.name.value))
+                        .with_help("rename the speed or the constraint"),
+                );
+            }
             // A frame's angular velocity keeps its name; a definition reads the rates only.
             if file.angular_velocity_name(&s.name.value).is_some() {
                 self.error(
@@ -102,7 +110,7 @@ impl Checker<'_> {
         // One speed per degree of freedom: per coordinate, less one per non-holonomic
         // constraint row (those rows become the auxiliary speeds held at 0).
         let (n, p) = (file.coordinates.len(), file.speeds.len());
-        let rows = file.nonholonomic_names().len();
+        let rows = rows.len();
         let plural = |k: usize| if k == 1 { "" } else { "s" };
         if n != p + rows && !self.incomplete.has_section("coordinates") {
             let message = if rows == 0 {
