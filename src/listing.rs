@@ -103,6 +103,9 @@ pub fn equations(
     };
     eomgen_symbolic::mechanics::finish_derivation(&mut model, &file)
         .map_err(ListingError::Diagnostics)?;
+    // Read on the constraints: a model in speeds beside non-holonomic constraints lists
+    // Kane's non-holonomic equations (its auxiliary speeds at 0).
+    let eom = eomgen_symbolic::mechanics::on_the_constraints(&mut model, &eom);
     let eom = eomgen_symbolic::codegen::readable_equations(&mut model, &eom);
     Ok(Equations {
         model: model.name.clone(),

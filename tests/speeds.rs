@@ -330,6 +330,17 @@ fn what_takes_the_rates_refuses_speeds_with_its_reason() {
         assert!(!out.status.success(), "{args:?}");
         assert!(err.contains(expected), "{args:?}: {err}");
     }
+    // The rolling-contact study reads the contact force on the coordinates' rates.
+    let disc = fixture("rolling_disc_speeds.yaml");
+    let out = eomgen(&["study", "rolling-contact", disc.as_str()]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{err}");
+    assert!(
+        err.contains(
+            "`rolling_disc_speeds` is in generalized speeds, and the rolling-contact study reads"
+        ),
+        "{err}"
+    );
     let text = std::fs::read_to_string(&top).expect("fixture");
     let mut model = load("heavy_top_speeds.yaml", &text);
     let y = model.initial_state();
@@ -507,8 +518,8 @@ fn rounding_of_the_speeds_is_not_a_coupling() {
 /// against the bundled disc in the rates with Lagrange's multipliers, from the same state
 /// (the rates from the kinematic equations), with DOP853 at rtol 1e-12 over 2 s: the
 /// coordinates agree to 1e-8 and the contact forces (the multipliers, the same rows in both)
-/// to 1e-7 relative, with the auxiliary speeds held to rounding. Also with Radau IIA through
-/// the exact Jacobian.
+/// to 1e-7 relative, with the auxiliary speeds held to rounding. Also with Radau IIA (its
+/// Jacobian by differences, as for every constrained model).
 #[test]
 fn a_rolling_disc_in_speeds_moves_as_with_multipliers_in_the_rates() {
     let options = |method, initial_state| SimulationOptions {
@@ -564,4 +575,37 @@ fn a_rolling_disc_in_speeds_moves_as_with_multipliers_in_the_rates() {
             );
         }
     }
+}
+
+/// The rolling disc in its body rates lists its equations on the constraints (the
+/// auxiliary speeds at 0): the kinematic equations carry no slip, `x' = r cos(yaw) (…)` the
+/// rolling condition, and `J` holds each auxiliary speed; `check` compares Kane's with
+/// Lagrange's carried into the speeds.
+#[test]
+fn a_rolling_disc_in_speeds_lists_kanes_non_holonomic_equations() {
+    let disc = fixture("rolling_disc_speeds.yaml");
+    let listing =
+        String::from_utf8_lossy(&eomgen_ok(&["equations", disc.as_str()]).stdout).to_string();
+    assert!(
+        listing.contains("on the constraints: the auxiliary speeds roll_x, roll_y at 0, where the rows of w1, w2, w3 are Kane's non-holonomic equations"),
+        "{listing}"
+    );
+    let kinematic: Vec<&str> = (listing.lines())
+        .skip_while(|l| !l.starts_with("q' = "))
+        .skip(1)
+        .take(5)
+        .collect();
+    assert!(
+        kinematic[0].starts_with("  x' = r*cos(yaw)*("),
+        "{kinematic:?}"
+    );
+    assert!(
+        kinematic.iter().all(|l| !l.contains("roll_")),
+        "{kinematic:?}"
+    );
+    assert!(listing.contains("  J[roll_x,roll_x] = 1\n"), "{listing}");
+    assert!(listing.contains("  J[roll_y,roll_y] = 1\n"), "{listing}");
+    let check = String::from_utf8_lossy(&eomgen_ok(&["check", disc.as_str()]).stdout).to_string();
+    assert!(check.contains("ok   lagrange vs kane"), "{check}");
+    assert!(!check.contains("integrable"), "{check}");
 }

@@ -489,9 +489,10 @@ impl<S: DynMechanicalSystem> DynFirstOrder<S> {
 }
 
 impl<S: DynMechanicalSystem> DynFirstOrder<S> {
-    /// The right-hand side `ẏ = [q̇; u̇]` of a model in generalized speeds (unconstrained: the
-    /// rules refuse speeds beside constraints): `q̇` from the kinematic equations
-    /// ([`DynMechanicalSystem::coordinate_rates`]), `u̇ = M⁻¹F`.
+    /// The right-hand side `ẏ = [q̇; u̇]` of a model in generalized speeds: `q̇` from the
+    /// kinematic equations ([`DynMechanicalSystem::coordinate_rates`]), `u̇` from `M u̇ = F`,
+    /// or beside non-holonomic constraints (their rows the auxiliary speeds, `J = [0 I]`) from
+    /// the constraints' index-1 system, as in the rates.
     fn rhs_in_speeds(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), RhsError> {
         let n = self.n;
         let (q, u) = (&y[..n], &y[n..2 * n]);

@@ -362,6 +362,19 @@ fn mistaken_speeds_are_located() {
         ),
         "{e}"
     );
+    // A row named as a speed's rate (each speed declares `<name>_dot`).
+    let e = lowering_error(&sliding("a: x_dot").replace("along:", "a_dot:"));
+    assert!(
+        e.contains("non-holonomic constraint row `a_dot` (or its rate `a_dot_dot`) is taken"),
+        "{e}"
+    );
+    let e = load_error(&sliding("a: x_dot").replace("x: 1", "x: { guess: 1 }"));
+    assert!(
+        e.contains("`x` is a guess, but a model in generalized speeds starts on its non-holonomic constraints"),
+        "{e}"
+    );
+    let e = load_error(&format!("{}outputs: {{ along: x }}\n", sliding("a: x_dot")));
+    assert!(e.contains("output name `along` is taken"), "{e}");
     let e = lowering_error(&sliding("a: x_dot - y_dot"));
     assert!(
         e.starts_with("3:11: the speeds do not determine the rates"),

@@ -95,6 +95,16 @@ pub enum RollingContactError {
         /// The model's events.
         known: Vec<String>,
     },
+    /// A model is in generalized speeds: the study reads the contact force as `−Jᵀλ` on
+    /// the coordinates and the velocity as the coordinates' rates, which its state does not
+    /// hold.
+    #[error(
+        "`{model}` is in generalized speeds, and the rolling-contact study reads the contact force and the velocity on the coordinates' rates: study the model in the rates (remove `speeds`)"
+    )]
+    InSpeeds {
+        /// The model's name.
+        model: String,
+    },
     /// The rolling model has no constraints, so no contact force.
     #[error("`{model}` has no constraints: nothing holds it on the ground")]
     NoConstraints {

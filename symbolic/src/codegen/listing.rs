@@ -236,6 +236,15 @@ pub fn equations_text(model: &SymbolicModel, eom: &EquationsOfMotion) -> String 
         } else {
             "q' = W(q, t) u"
         };
+        if let Some(sp) = model.speeds.as_ref().filter(|sp| sp.on_the_constraints) {
+            let (independent, auxiliary) = e.speeds.split_at(e.speeds.len() - sp.auxiliary);
+            let _ = writeln!(
+                s,
+                "on the constraints: the auxiliary speeds {} at 0, where the rows of {} are Kane's non-holonomic equations",
+                auxiliary.join(", "),
+                independent.join(", ")
+            );
+        }
         let _ = writeln!(s, "{form} (the kinematic equations) with");
         for (q, k) in e.coordinates.iter().zip(&e.kinematic_equations) {
             let _ = writeln!(s, "  {q}' = {k}");

@@ -130,6 +130,9 @@ pub struct Speeds {
     /// How many of [`Self::names`] are the non-holonomic constraint rows' auxiliary speeds
     /// (the last ones): `uᵣ = A q̇ + b` of its row, held at 0 by its multiplier.
     pub auxiliary: usize,
+    /// Whether the model's expressions (and the equations listed with it) have been taken on
+    /// the constraints, the auxiliary speeds at 0 ([`super::on_the_constraints`]), to be read.
+    pub on_the_constraints: bool,
     /// The kinematic equations: `q̇ⱼ` as an expression of `q`, `u` and `t`, per coordinate.
     pub kinematic_equations: Vec<ExprId>,
     /// `Y`, `n × n` row-major: `u = Y q̇ + Z` (the auxiliary speeds' rows are the

@@ -34,7 +34,7 @@ pub use lower::{
 pub use mass::mass_matrix_diagnostics;
 pub use momentum::MomentumBalance;
 pub use preferred::{preferred_equations, preferred_formulation};
-pub use speeds::Kane;
+pub use speeds::{Kane, on_the_constraints};
 
 use crate::expr::ExprId;
 

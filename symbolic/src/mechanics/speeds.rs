@@ -190,7 +190,13 @@ pub(crate) fn switch(
         arena.symbol_id(name).is_some() || arena.symbol_id(&format!("{name}_dot")).is_some()
     };
     // (A speed named as a constraint row is the model checks' error; refused here too.)
-    let repeated = |r: usize| names[..r].contains(&names[r]);
+    // Each speed declares its name and its rate `<name>_dot`: neither may be another's.
+    let repeated = |r: usize| {
+        names[..r].iter().any(|other| {
+            let (a, b) = (other.as_str(), names[r].as_str());
+            a == b || a.strip_suffix("_dot") == Some(b) || b.strip_suffix("_dot") == Some(a)
+        })
+    };
     if let Some(r) = (0..names.len()).find(|&r| taken(&names[r]) || repeated(r)) {
         let name = &names[r];
         let (what, location, help) = match file.speeds.get(r) {
@@ -236,6 +242,7 @@ pub(crate) fn switch(
     let speeds = Speeds {
         names,
         auxiliary: auxiliary.len(),
+        on_the_constraints: false,
         coefficients: y,
         kinematic_equations: rates,
         inverse,
@@ -310,7 +317,9 @@ pub(crate) fn switch(
             u0
         }
         None => {
+            // The state at t = 0 (a speed, or a constraint row, may read `t`).
             let mut start: FxHashMap<SymbolId, ExprId> = FxHashMap::default();
+            start.insert(model.time_id, zero);
             for (j, s) in old.iter().enumerate() {
                 start.insert(s[0], model.initial_q[j]);
                 start.insert(s[1], model.initial_qdot[j]);
@@ -331,6 +340,40 @@ pub(crate) fn switch(
     });
     super::finish_derivation(&mut model, file)?;
     Ok(model)
+}
+
+/// The equations `eom` of `model` on its non-holonomic constraints, to be read: every
+/// auxiliary speed 0 in `F`, `M`, the kinetic energy, the generalized forces and the kinematic
+/// equations (as it is along every motion), so that the rows of the independent speeds are
+/// Kane's non-holonomic equations (Kane & Levinson §6.1) and the auxiliary rows give the
+/// multipliers. `eom` as it is for a model without auxiliary speeds. For printing only: the
+/// Jacobians in the auxiliary speeds are lost.
+pub fn on_the_constraints(model: &mut SymbolicModel, eom: &EquationsOfMotion) -> EquationsOfMotion {
+    let Some(speeds) = model.speeds.as_mut().filter(|s| s.auxiliary > 0) else {
+        return eom.clone();
+    };
+    let arena = &mut model.arena;
+    let zero = arena.int(0);
+    let n = arena.coordinates().len();
+    let at_zero: FxHashMap<SymbolId, ExprId> = (arena.coordinates()[n - speeds.auxiliary..])
+        .iter()
+        .map(|s| (s[1], zero))
+        .collect();
+    let mut memo = FxHashMap::default();
+    let mut on = |arena: &mut ExprArena, e: &mut ExprId| {
+        *e = arena.substitute_memo(*e, &at_zero, &mut memo);
+    };
+    let mut out = eom.clone();
+    for e in (out.mass_matrix.iter_mut())
+        .chain(out.forcing.iter_mut())
+        .chain(speeds.kinematic_equations.iter_mut())
+        .chain(model.generalized_forces.iter_mut())
+        .chain([&mut model.kinetic])
+    {
+        on(arena, e);
+    }
+    speeds.on_the_constraints = true;
+    out
 }
 
 /// The non-holonomic constraints in the speeds: row `i` (of `m`, after the `holonomic`

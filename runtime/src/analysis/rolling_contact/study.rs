@@ -54,6 +54,14 @@ pub fn rolling_contact(
     options: &RollingContactOptions,
 ) -> Result<RollingContact, RollingContactError> {
     check_options(options)?;
+    if let Some(model) = std::iter::once(&*rolling)
+        .chain(flight.as_deref())
+        .find(|m| m.description().has_speeds())
+    {
+        return Err(RollingContactError::InSpeeds {
+            model: model.description().name.to_string(),
+        });
+    }
     let name = rolling.description().name.to_string();
     let ground = coordinate(rolling, "ground", &options.ground)?;
     let normal = coordinate(rolling, "normal", &options.normal)?;

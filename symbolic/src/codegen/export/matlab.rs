@@ -133,10 +133,11 @@ impl Exported<'_> {
                 false => "u'",
             },
         );
+        let a = if self.speeds.is_empty() { "q''" } else { "u'" };
         if m > 0 {
             let _ = writeln!(
                 s,
-                "function lambda = multipliers(t, q, qd, p)\n% lambda ({m}): M q'' = F - J' lambda.\nif nargin < 4 || isempty(p), p = parameters(); end\nx = accelerations(t, q, qd, p);\nlambda = x({}:{});\nend\n\nfunction x = accelerations(t, q, qd, p)\n% [q''; lambda] of [M J'; J 0][q''; lambda] = [F; gamma].\n[M, F] = mass_matrix_and_forcing(t, q, qd, p);\nJ = constraint_jacobian(t, q, p);\ngamma = constraint_gamma(t, q, qd, p);\nx = [M, J'; J, zeros({m})] \\ [F; gamma];\nend",
+                "function lambda = multipliers(t, q, qd, p)\n% lambda ({m}): M {a} = F - J' lambda.\nif nargin < 4 || isempty(p), p = parameters(); end\nx = accelerations(t, q, qd, p);\nlambda = x({}:{});\nend\n\nfunction x = accelerations(t, q, qd, p)\n% [{a}; lambda] of [M J'; J 0][{a}; lambda] = [F; gamma].\n[M, F] = mass_matrix_and_forcing(t, q, qd, p);\nJ = constraint_jacobian(t, q, p);\ngamma = constraint_gamma(t, q, qd, p);\nx = [M, J'; J, zeros({m})] \\ [F; gamma];\nend",
                 n + 1,
                 n + m
             );

@@ -392,7 +392,10 @@ impl<'a> Exported<'a> {
                 )],
             });
         }
-        functions.extend(constraint_functions(program));
+        functions.extend(constraint_functions(
+            program,
+            !program.description.speeds.is_empty(),
+        ));
         if d.has_speeds() {
             functions.push(Function {
                 name: "coordinate_rates",
@@ -479,9 +482,12 @@ impl<'a> Exported<'a> {
                 literal(*value)
             ));
         }
+        // In speeds the constraints are over the speeds (a non-holonomic row is its
+        // auxiliary speed, held at 0).
+        let a = if self.speeds.is_empty() { "q''" } else { "u'" };
         if m > 0 {
             lines.push(format!(
-                "Constraints ({m}, the first {} holonomic): [M J'; J 0][q''; lambda] = [F; gamma], so M q'' = F - J' lambda:",
+                "Constraints ({m}, the first {} holonomic): [M J'; J 0][{a}; lambda] = [F; gamma], so M {a} = F - J' lambda:",
                 self.holonomic
             ));
             for (i, c) in self.constraints.iter().enumerate() {
@@ -523,8 +529,13 @@ impl<'a> Exported<'a> {
                 }
             ),
             false => format!(
-                "  rhs(t, y, p): dy/dt = [q'; u'] ({}), q' from coordinate_rates, u' from M u' = F",
-                2 * n
+                "  rhs(t, y, p): dy/dt = [q'; u'] ({}), q' from coordinate_rates, u' {}",
+                2 * n,
+                if m > 0 {
+                    "from the constraints' index-1 system (J over the speeds: each non-holonomic row's auxiliary speed held at 0)"
+                } else {
+                    "from M u' = F"
+                }
             ),
         });
         if m > 0 {
@@ -556,7 +567,8 @@ fn omitted(d: &eomgen_description::ModelDescription) -> Vec<String> {
 
 /// The constraints' functions of a constrained model (`Φ` where some are holonomic, `J`,
 /// `γ`); none without constraints.
-fn constraint_functions(program: &ModelProgram) -> Vec<Function<'_>> {
+fn constraint_functions(program: &ModelProgram, speeds: bool) -> Vec<Function<'_>> {
+    let a = if speeds { "u'" } else { "q''" };
     let d = &program.description;
     let (n, m) = (d.coordinates.len(), d.constraints.len());
     let outputs = |f: &FunctionTape| f.tape.outputs.clone();
@@ -579,7 +591,7 @@ fn constraint_functions(program: &ModelProgram) -> Vec<Function<'_>> {
     }
     functions.push(Function {
         name: "constraint_jacobian",
-        doc: format!("J ({m} x {n}) of the constraints J q'' = gamma"),
+        doc: format!("J ({m} x {n}) of the constraints J {a} = gamma"),
         args: CONFIGURATION,
         tape: &program.constraint_jacobian.tape,
         outputs: vec![Output::row_major(
@@ -591,7 +603,7 @@ fn constraint_functions(program: &ModelProgram) -> Vec<Function<'_>> {
     });
     functions.push(Function {
         name: "constraint_gamma",
-        doc: format!("gamma ({m}) of the constraints J q'' = gamma"),
+        doc: format!("gamma ({m}) of the constraints J {a} = gamma"),
         args: STATE,
         tape: &program.constraint_gamma.tape,
         outputs: vec![Output::vector("gamma", &outputs(&program.constraint_gamma))],

@@ -61,26 +61,26 @@ impl Exported<'_> {
             let _ = writeln!(s, "    return {}\n", names.join(", "));
         }
         let (n, m) = (self.n(), self.m());
+        // In speeds `q'` comes from the kinematic equations, and `qd'` is `u'`.
+        let (rates, q_rate, a, from) = match self.speeds.is_empty() {
+            true => ("qd", "qd", "q''", ""),
+            false => (
+                "coordinate_rates(t, q, qd, p)",
+                "q'",
+                "u'",
+                ", q' from coordinate_rates",
+            ),
+        };
         if m == 0 {
             let _ = writeln!(
                 s,
-                "\ndef rhs(t, y, p=PARAMETERS):\n    \"\"\"dy/dt = {what}.\"\"\"\n    y = np.asarray(y, dtype=float)\n    q, qd = y[:{n}], y[{n}:]\n    M, F = mass_matrix_and_forcing(t, q, qd, p)\n    return np.concatenate(({rates}, np.linalg.solve(M, F)))",
-                rates = match self.speeds.is_empty() {
-                    true => "qd",
-                    false => "coordinate_rates(t, q, qd, p)",
-                },
-                what = match self.speeds.is_empty() {
-                    true => format!("[qd; q''] ({}), q'' from M q'' = F", 2 * n),
-                    false => format!(
-                        "[q'; u'] ({}), q' from coordinate_rates, u' from M u' = F",
-                        2 * n
-                    ),
-                },
+                "\ndef rhs(t, y, p=PARAMETERS):\n    \"\"\"dy/dt = [{q_rate}; {a}] ({}){from}, {a} from M {a} = F.\"\"\"\n    y = np.asarray(y, dtype=float)\n    q, qd = y[:{n}], y[{n}:]\n    M, F = mass_matrix_and_forcing(t, q, qd, p)\n    return np.concatenate(({rates}, np.linalg.solve(M, F)))",
+                2 * n
             );
         } else {
             let _ = writeln!(
                 s,
-                "\ndef _accelerations(t, q, qd, p):\n    \"\"\"[q''; lambda] of [M J'; J 0][q''; lambda] = [F; gamma].\"\"\"\n    M, F = mass_matrix_and_forcing(t, q, qd, p)\n    J = constraint_jacobian(t, q, p)\n    gamma = constraint_gamma(t, q, qd, p)\n    A = np.block([[M, J.T], [J, np.zeros(({m}, {m}))]])\n    return np.linalg.solve(A, np.concatenate((F, gamma)))\n\n\ndef rhs(t, y, p=PARAMETERS):\n    \"\"\"dy/dt = [qd; q''] ({}), q'' from the constraints' index-1 system.\"\"\"\n    y = np.asarray(y, dtype=float)\n    q, qd = y[:{n}], y[{n}:]\n    return np.concatenate((qd, _accelerations(t, q, qd, p)[:{n}]))\n\n\ndef multipliers(t, q, qd, p=PARAMETERS):\n    \"\"\"lambda ({m}): M q'' = F - J' lambda.\"\"\"\n    return _accelerations(t, np.asarray(q, dtype=float), np.asarray(qd, dtype=float), p)[{n}:]",
+                "\ndef _accelerations(t, q, qd, p):\n    \"\"\"[{a}; lambda] of [M J'; J 0][{a}; lambda] = [F; gamma].\"\"\"\n    M, F = mass_matrix_and_forcing(t, q, qd, p)\n    J = constraint_jacobian(t, q, p)\n    gamma = constraint_gamma(t, q, qd, p)\n    A = np.block([[M, J.T], [J, np.zeros(({m}, {m}))]])\n    return np.linalg.solve(A, np.concatenate((F, gamma)))\n\n\ndef rhs(t, y, p=PARAMETERS):\n    \"\"\"dy/dt = [{q_rate}; {a}] ({}){from}, {a} from the constraints' index-1 system.\"\"\"\n    y = np.asarray(y, dtype=float)\n    q, qd = y[:{n}], y[{n}:]\n    return np.concatenate(({rates}, _accelerations(t, q, qd, p)[:{n}]))\n\n\ndef multipliers(t, q, qd, p=PARAMETERS):\n    \"\"\"lambda ({m}): M {a} = F - J' lambda.\"\"\"\n    return _accelerations(t, np.asarray(q, dtype=float), np.asarray(qd, dtype=float), p)[{n}:]",
                 2 * n
             );
         }

@@ -77,7 +77,16 @@ impl Checker<'_> {
         let Some(first) = file.speeds.first() else {
             return;
         };
+        // Guesses are solved with their rates from the constraints; in speeds the auxiliary
+        // speeds start on them instead.
+        // (Without constraints the guess is refused above.)
         let rows = file.nonholonomic_names();
+        for g in file.initial_guesses.iter().filter(|_| !rows.is_empty()) {
+            self.error(
+                Diagnostic::new(g.location, format!("`{}` is a guess, but a model in generalized speeds starts on its non-holonomic constraints with its auxiliary speeds at 0: it has nothing to solve", g.value))
+                    .with_help(format!("give its value directly: `initial: {{ {}: 0.5 }}`", g.value)),
+            );
+        }
         for s in &file.speeds {
             s.rules(self);
             // A non-holonomic constraint row is an auxiliary speed of its own name.

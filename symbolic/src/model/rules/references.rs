@@ -436,6 +436,15 @@ impl Checker<'_> {
     // in a simulation's output (`t`, the coordinates and rates, `energy`).
     pub(super) fn outputs(&mut self) {
         let file = self.file;
+        // Beside speeds, each non-holonomic constraint row is a speed (an auxiliary one).
+        let auxiliary: Vec<String> = match file.speeds.is_empty() {
+            true => Vec::new(),
+            false => file
+                .nonholonomic_names()
+                .into_iter()
+                .map(|k| k.value)
+                .collect(),
+        };
         for o in &file.outputs {
             let n = o.name.value.as_str();
             if n == "t"
@@ -443,6 +452,7 @@ impl Checker<'_> {
                 || self.sets.coords.contains(n)
                 || self.sets.rates.contains(n)
                 || self.sets.speeds.contains(n)
+                || auxiliary.iter().any(|a| a == n)
             {
                 self.error(
                     Diagnostic::new(
