@@ -161,9 +161,10 @@ fn array(values: &[f64]) -> String {
     format!("{{{}}}", items.join(", "))
 }
 
-/// The files exported: every bundled model and three fixtures in generalized speeds (whose
-/// `qd` is `u` and whose `rhs` takes `q̇` from `coordinate_rates`; the rolling disc's with its
-/// auxiliary speeds held by `J = [0 I]`), as `(name, file, text)`.
+/// The files exported: every bundled model and four fixtures in generalized speeds (whose
+/// `qd` is `u` and whose `rhs` takes `q̇` from `coordinate_rates`; the rolling disc's and the
+/// Euler parameters' with their auxiliary speeds held by `J = [0 I]`), as
+/// `(name, file, text)`.
 fn exported_files() -> Vec<(String, String, String)> {
     let bundled = eomgen::models::ALL.iter().map(|entry| {
         (
@@ -176,6 +177,7 @@ fn exported_files() -> Vec<(String, String, String)> {
         "free_rigid_body_speeds",
         "heavy_top_speeds",
         "rolling_disc_speeds",
+        "free_rigid_body_quaternion_speeds",
     ]
     .map(|name| {
         let file = format!("{}/tests/fixtures/{name}.yaml", env!("CARGO_MANIFEST_DIR"));

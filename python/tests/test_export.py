@@ -30,12 +30,14 @@ def _close(exported, reference):
 _FIXTURES = __import__("pathlib").Path(__file__).resolve().parents[2] / "tests" / "fixtures"
 
 
-# Every bundled model, and three in generalized speeds (their ``qd`` is ``u``; ``rhs`` takes the
-# rates from ``coordinate_rates``; the rolling disc's holds its auxiliary speeds at 0).
+# Every bundled model, and four in generalized speeds (their ``qd`` is ``u``; ``rhs`` takes the
+# rates from ``coordinate_rates``; the rolling disc and the Euler parameters hold their
+# auxiliary speeds at 0).
 @pytest.mark.parametrize("name", eomgen.bundled_models() + [
     str(_FIXTURES / "free_rigid_body_speeds.yaml"),
     str(_FIXTURES / "heavy_top_speeds.yaml"),
     str(_FIXTURES / "rolling_disc_speeds.yaml"),
+    str(_FIXTURES / "free_rigid_body_quaternion_speeds.yaml"),
 ])
 def test_exported_python_computes_what_eomgen_computes(name):
     model = eomgen.load(name)

@@ -151,6 +151,9 @@ pub(super) fn modal_hint(model: &dyn ModelInfo, e: &eomgen::ModalError) -> Strin
         ModalError::SpeedsInMotion { .. } => {
             "linearise the model at rest (all coordinates' rates 0), or remove `speeds` to linearise it in the rates".to_string()
         }
+        ModalError::SpeedsBesideConstraints { .. } => format!(
+            "`eomgen simulate {name}` follows its motion; remove `speeds` to find its equilibria and modes in the coordinates' rates"
+        ),
         ModalError::SpeedsDependOnTime => {
             "remove `speeds` to find its equilibria and modes in the coordinates' rates".to_string()
         }

@@ -135,6 +135,16 @@ pub enum SimulationError {
     /// The drift control's gains cannot be used (a negative Baumgarte gain).
     #[error(transparent)]
     InvalidStabilization(#[from] StabilizationError),
+    /// Projection asked of a model in generalized speeds with holonomic constraints: its
+    /// constraint Jacobian is over the speeds (`J = [0 I]`, the auxiliary speeds), not the
+    /// `∂Φ/∂q` that the projection of the coordinates onto `Φ = 0` steps along.
+    #[error(
+        "`{model}` is in generalized speeds beside holonomic constraints, whose Jacobian is over the speeds: projection, which steps the coordinates along ∂Φ/∂q, is not available; take Baumgarte's stabilisation or none"
+    )]
+    ProjectionInSpeeds {
+        /// The model.
+        model: String,
+    },
     /// The initial state is inside a unilateral contact: its gap is negative.
     #[error(
         "the initial state is inside contact `{contact}`: its gap is {gap:e} (a gap is 0 or more, 0 where the contact touches)"
@@ -316,6 +326,15 @@ pub fn simulate_with_events(
     added: Option<&mut dyn AddedEvents>,
 ) -> Result<Simulation, SimulationError> {
     options.stabilization.validate()?;
+    let d = model.description();
+    if options.stabilization == Stabilization::Projection
+        && d.has_speeds()
+        && d.holonomic_constraints > 0
+    {
+        return Err(SimulationError::ProjectionInSpeeds {
+            model: d.name.to_string(),
+        });
+    }
     let y0 = consistent_start(model, options)?;
     model.set_stabilization(options.stabilization);
     if !(options.t_end.is_finite() && options.t_end > 0.0) {

@@ -218,6 +218,17 @@ pub enum ModalError {
         "the generalized speeds depend on t (u = Y(q, t) q' + Z(q, t)), so rest (q' = 0) moves with t in the speeds: equilibria and linearisations are found in the coordinates' rates"
     )]
     SpeedsDependOnTime,
+    /// A model in generalized speeds beside constraints (their rows its auxiliary speeds):
+    /// rest and the linearisation in speeds are derived for unconstrained models.
+    #[error(
+        "the model is in generalized speeds beside the constraint `{constraint}`: equilibria and linearisations in speeds are derived without constraints"
+    )]
+    SpeedsBesideConstraints {
+        /// The model.
+        model: String,
+        /// Its first constraint.
+        constraint: String,
+    },
     /// The kinematic equations of a model in generalized speeds are singular there: `W` is
     /// not invertible or not finite (Euler angles at gimbal lock).
     #[error(
@@ -369,6 +380,12 @@ fn check_mass_matrix(mass: &DMatrix<f64>, names: &[&str], q: &[f64]) -> Result<(
 pub(super) fn check_point(model: &dyn ModelInfo, q: &[f64]) -> Result<(), ModalError> {
     let names = model.description().constraint_names();
     let h = model.description().holonomic_constraints;
+    if model.description().has_speeds() && !names.is_empty() {
+        return Err(ModalError::SpeedsBesideConstraints {
+            model: model.description().name.to_string(),
+            constraint: names[0].to_string(),
+        });
+    }
     if names.len() > h {
         return Err(ModalError::NonHolonomic {
             model: model.description().name.to_string(),

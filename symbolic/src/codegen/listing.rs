@@ -240,7 +240,7 @@ pub fn equations_text(model: &SymbolicModel, eom: &EquationsOfMotion) -> String 
             let (independent, auxiliary) = e.speeds.split_at(e.speeds.len() - sp.auxiliary);
             let _ = writeln!(
                 s,
-                "on the constraints: the auxiliary speeds {} at 0, where the rows of {} are Kane's non-holonomic equations",
+                "on the constraints: the auxiliary speeds {} at 0, where the rows of {} are Kane's equations of the independent speeds",
                 auxiliary.join(", "),
                 independent.join(", ")
             );

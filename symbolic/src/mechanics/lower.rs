@@ -124,11 +124,11 @@ pub enum BalanceInfo {
 /// used by `super::speeds`).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Speeds {
-    /// The speeds' names, one per coordinate: the file's, in file order, then the
-    /// non-holonomic constraint rows' (their auxiliary speeds, held at 0 by the constraints).
+    /// The speeds' names, one per coordinate: the file's, in file order, then the constraint
+    /// rows' (their auxiliary speeds, held at 0 by the constraints).
     pub names: Vec<String>,
-    /// How many of [`Self::names`] are the non-holonomic constraint rows' auxiliary speeds
-    /// (the last ones): `uᵣ = A q̇ + b` of its row, held at 0 by its multiplier.
+    /// How many of [`Self::names`] are the constraint rows' auxiliary speeds (the last ones):
+    /// `uᵣ = A q̇ + b` (`J q̇ + Φ_t` of a holonomic row), held at 0 by its multiplier.
     pub auxiliary: usize,
     /// Whether the model's expressions (and the equations listed with it) have been taken on
     /// the constraints, the auxiliary speeds at 0 ([`super::on_the_constraints`]), to be read.

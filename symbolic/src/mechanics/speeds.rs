@@ -29,9 +29,10 @@
 //! and Lagrange's equations `M_q q̈ = F_q` (derived before the switch) carry into
 //! `Wᵀ M_q W u̇ = Wᵀ (F_q − M_q Ẇ (u − Z) − M_q W Ż)`, which the checks compare.
 //!
-//! Beside `m` non-holonomic constraints `A q̇ + b = 0` the file gives `n − m` speeds, and each
-//! constraint row is an auxiliary speed `A q̇ + b` of its name (§§2.13, 4.4), the last rows of
-//! `Y`, held at 0 by the constraint `u = 0` (`J = [0 I]`, `γ = 0`). The constraint forces
+//! Beside `m` constraint rows the file gives `n − m` speeds, and each row's velocity form,
+//! `A q̇ + b` (`J q̇ + Φ_t` for a holonomic `Φ(q, t) = 0`, which keeps its `Φ` for the drift),
+//! is an auxiliary speed of its name (§§2.13, 4.4), the last rows of `Y`, held at 0 by the
+//! constraint `u = 0` (`J = [0 I]`, `γ = 0`). The constraint forces
 //! `Aᵀλ` on the coordinates are `[0; λ]` on the speeds (`A W = [0 I]`): Kane's rows of the
 //! independent speeds at the auxiliary speeds 0 are the non-holonomic equations, and the
 //! auxiliary rows give the multipliers, as in the rates.
@@ -106,13 +107,11 @@ pub(crate) fn switch(
     file: &ModelFile,
 ) -> Result<SymbolicModel, Vec<Diagnostic>> {
     let n = model.num_dofs();
-    // Each non-holonomic constraint row `A q̇ + b` is an auxiliary speed held at 0 (Kane &
-    // Levinson §§2.13, 4.4): with the file's speeds it determines the rates, and its
-    // constraint becomes `uᵣ = 0` (see [`auxiliary_constraints`]).
-    let holonomic = model.constraints.holonomic;
+    // Each constraint row's velocity form, `J q̇ + Φ_t` or `A q̇ + b`, is an auxiliary speed
+    // held at 0 (Kane & Levinson §§2.13, 4.4): with the file's speeds it determines the
+    // rates, and its constraint becomes `uᵣ = 0` (see [`auxiliary_constraints`]).
     let auxiliary: Vec<(String, ExprId)> = (model.constraints.names.iter().cloned())
         .zip(model.constraints.velocity.iter().copied())
-        .skip(holonomic)
         .collect();
     let definitions: Vec<ExprId> = (definitions.iter().copied())
         .chain(auxiliary.iter().map(|(_, g)| *g))
@@ -177,7 +176,7 @@ pub(crate) fn switch(
         let first = &file.speeds[0];
         return Err(vec![
             Diagnostic::new(first.name.location, "the speeds do not determine the rates: the determinant of their coefficients in the rates is identically 0")
-                .with_help("choose speeds that are independent combinations of the rates, one per degree of freedom, and independent of the non-holonomic constraints"),
+                .with_help("choose speeds that are independent combinations of the rates, one per degree of freedom, and independent of the constraints"),
         ]);
     }
     let inverse: Vec<ExprId> = adjugate
@@ -202,12 +201,12 @@ pub(crate) fn switch(
         let (what, location, help) = match file.speeds.get(r) {
             Some(speed) => ("speed name", speed.name.location, "rename the speed"),
             None => (
-                "non-holonomic constraint row",
-                (file.nonholonomic_names().iter())
+                "constraint row",
+                (file.constraint_names().iter())
                     .find(|k| k.value == *name)
                     .map(|k| k.location)
                     .unwrap_or(file.speeds[0].name.location),
-                "rename the constraint: with `speeds`, each row of a non-holonomic constraint is an auxiliary speed of its name",
+                "rename the constraint: with `speeds`, each constraint row is an auxiliary speed of its name",
             ),
         };
         return Err(vec![
@@ -342,10 +341,10 @@ pub(crate) fn switch(
     Ok(model)
 }
 
-/// The equations `eom` of `model` on its non-holonomic constraints, to be read: every
+/// The equations `eom` of `model` on its constraints, to be read: every
 /// auxiliary speed 0 in `F`, `M`, the kinetic energy, the generalized forces and the kinematic
 /// equations (as it is along every motion), so that the rows of the independent speeds are
-/// Kane's non-holonomic equations (Kane & Levinson §6.1) and the auxiliary rows give the
+/// Kane's equations for them (Kane & Levinson §6.1) and the auxiliary rows give the
 /// multipliers. `eom` as it is for a model without auxiliary speeds. For printing only: the
 /// Jacobians in the auxiliary speeds are lost.
 pub fn on_the_constraints(model: &mut SymbolicModel, eom: &EquationsOfMotion) -> EquationsOfMotion {
@@ -376,9 +375,9 @@ pub fn on_the_constraints(model: &mut SymbolicModel, eom: &EquationsOfMotion) ->
     out
 }
 
-/// The non-holonomic constraints in the speeds: row `i` (of `m`, after the `holonomic`
-/// rows, of which there are none beside speeds) is `u_{n−m+i} = 0`, its auxiliary speed, so
-/// `J = [0 I]`, the velocity residual is that speed and `γ = 0`. The multipliers are the
+/// The constraints in the speeds: row `i` of `m` is `u_{n−m+i} = 0`, its auxiliary speed,
+/// so `J = [0 I]`, the velocity residual is that speed and `γ = 0`; a holonomic row keeps
+/// its `Φ(q, t)` (for the drift and Baumgarte's position term). The multipliers are the
 /// constraint forces as in the rates: `Q = Aᵀλ` on the coordinates is `W̄ᵀAᵀλ = [0; λ]` on
 /// the speeds, since `A W̄ = [0 I]`.
 fn auxiliary_constraints(
@@ -387,7 +386,6 @@ fn auxiliary_constraints(
     u: &[ExprId],
 ) -> super::ConstraintEquations {
     let (n, m) = (u.len(), constraints.len());
-    debug_assert_eq!(constraints.holonomic, 0, "refused by the model's rules");
     let (zero, one) = (arena.int(0), arena.int(1));
     let mut jacobian = vec![zero; m * n];
     for i in 0..m {
@@ -395,8 +393,8 @@ fn auxiliary_constraints(
     }
     super::ConstraintEquations {
         names: constraints.names.clone(),
-        holonomic: 0,
-        phi: Vec::new(),
+        holonomic: constraints.holonomic,
+        phi: constraints.phi.clone(),
         jacobian,
         velocity: u[n - m..].to_vec(),
         gamma: vec![zero; m],

@@ -66,33 +66,32 @@ impl Checker<'_> {
     }
 
     // Rule (`speeds:`): one generalized speed per degree of freedom (per coordinate, less one
-    // per non-holonomic constraint row), each read where the rates may be, defined by the
-    // rates (not other speeds) and not named as an angular velocity, in a model of the
-    // kinematic form; `initial:` gives the speeds or the rates, not both. The equations in
-    // speeds are derived for systems without holonomic constraints or contacts (Kane and
-    // Levinson, ch. 6: holonomic constraints, contacts, balances and hand-written equations
-    // in speeds are not supported).
+    // per constraint row), each read where the rates may be, defined by the rates (not other
+    // speeds) and not named as an angular velocity, in a model of the kinematic form;
+    // `initial:` gives the speeds or the rates, not both, and no guesses. The equations in
+    // speeds are derived for systems without contacts (Kane and Levinson, ch. 6: contacts,
+    // balances and hand-written equations in speeds are not supported).
     pub(super) fn speeds(&mut self) {
         let file = self.file;
         let Some(first) = file.speeds.first() else {
             return;
         };
-        // Guesses are solved with their rates from the constraints; in speeds the auxiliary
-        // speeds start on them instead.
-        // (Without constraints the guess is refused above.)
-        let rows = file.nonholonomic_names();
+        // Guesses are solved with their rates from the constraints' `Φ` and `J` in the
+        // coordinates; in speeds `J` is over the speeds, and the auxiliary speeds start on the
+        // constraints instead. (Without constraints the guess is refused above.)
+        let rows = file.constraint_names();
         for g in file.initial_guesses.iter().filter(|_| !rows.is_empty()) {
             self.error(
-                Diagnostic::new(g.location, format!("`{}` is a guess, but a model in generalized speeds starts on its non-holonomic constraints with its auxiliary speeds at 0: it has nothing to solve", g.value))
-                    .with_help(format!("give its value directly: `initial: {{ {}: 0.5 }}`", g.value)),
+                Diagnostic::new(g.location, format!("`{}` is a guess, but a model in generalized speeds does not solve its initial state from the constraints: its auxiliary speeds start at 0", g.value))
+                    .with_help(format!("give the coordinates on the constraints: `initial: {{ {}: 0.5 }}`", g.value)),
             );
         }
         for s in &file.speeds {
             s.rules(self);
-            // A non-holonomic constraint row is an auxiliary speed of its own name.
+            // A constraint row is an auxiliary speed of its own name.
             if rows.iter().any(|r| r.value == s.name.value) {
                 self.error(
-                    Diagnostic::new(s.name.location, format!("speed name `{}` is taken: it names a row of a non-holonomic constraint, whose auxiliary speed it is", s.name.value))
+                    Diagnostic::new(s.name.location, format!("speed name `{}` is taken: it names a constraint row, whose auxiliary speed it is", s.name.value))
                         .with_help("rename the speed or the constraint"),
                 );
             }
@@ -116,10 +115,10 @@ impl Checker<'_> {
                 );
             }
         }
-        // One speed per degree of freedom: per coordinate, less one per non-holonomic
-        // constraint row (those rows become the auxiliary speeds held at 0).
+        // One speed per degree of freedom: per coordinate, less one per constraint row (those
+        // rows become the auxiliary speeds held at 0).
         let (n, p) = (file.coordinates.len(), file.speeds.len());
-        let rows = rows.len();
+        let rows = file.constraint_names().len();
         let plural = |k: usize| if k == 1 { "" } else { "s" };
         if n != p + rows && !self.incomplete.has_section("coordinates") {
             let message = if rows == 0 {
@@ -130,7 +129,7 @@ impl Checker<'_> {
                 )
             } else {
                 format!(
-                    "the model has {n} coordinate{} and {rows} non-holonomic constraint row{} but {p} speed{}: `speeds` gives one per degree of freedom, {}",
+                    "the model has {n} coordinate{} and {rows} constraint row{} but {p} speed{}: `speeds` gives one per degree of freedom, {}",
                     plural(n),
                     plural(rows),
                     plural(p),
@@ -139,7 +138,7 @@ impl Checker<'_> {
             };
             self.error(
                 Diagnostic::new(first.name.location, message)
-                    .with_help("each speed is a combination of the rates, such as `w1: omega_B_x`; together with the non-holonomic constraints they must determine every rate"),
+                    .with_help("each speed is a combination of the rates, such as `w1: omega_B_x`; together with the constraints they must determine every rate"),
             );
         }
         if file.kinetic.is_some()
@@ -151,10 +150,6 @@ impl Checker<'_> {
             );
         }
         let unsupported = [
-            (
-                !file.holonomic_names().is_empty(),
-                "holonomic constraints (including a frame's Euler parameters)",
-            ),
             (!file.contacts.is_empty(), "contacts"),
             (!file.balances.is_empty(), "balances"),
             (

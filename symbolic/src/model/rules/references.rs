@@ -436,11 +436,11 @@ impl Checker<'_> {
     // in a simulation's output (`t`, the coordinates and rates, `energy`).
     pub(super) fn outputs(&mut self) {
         let file = self.file;
-        // Beside speeds, each non-holonomic constraint row is a speed (an auxiliary one).
+        // Beside speeds, each constraint row is a speed (an auxiliary one).
         let auxiliary: Vec<String> = match file.speeds.is_empty() {
             true => Vec::new(),
             false => file
-                .nonholonomic_names()
+                .constraint_names()
                 .into_iter()
                 .map(|k| k.value)
                 .collect(),
