@@ -661,3 +661,25 @@ fn euler_parameters_in_body_rates_move_as_in_the_rates() {
         "{error}"
     );
 }
+
+/// `check` of a heavy top in Euler parameters with its tip pinned by holonomic constraints and
+/// its body rates as the speeds, whose `M` is singular along the norm: both derivations agree
+/// through the KKT system, and the power balance holds at states on the velocity constraints
+/// (the constraint forces do no work there). Elimination (`reduce`) refuses speeds.
+#[test]
+fn a_pinned_top_in_euler_parameters_and_body_rates_checks() {
+    let top = fixture("heavy_top_quaternion_speeds.yaml");
+    let check = String::from_utf8_lossy(&eomgen_ok(&["check", top.as_str()]).stdout).to_string();
+    assert!(check.contains("ok   lagrange vs kane"), "{check}");
+    assert!(check.contains("ok   power balance"), "{check}");
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let pendulum = written(
+        &dir,
+        "pendulum.yaml",
+        "name: p\nparameters: { m: 1, l: 1, g: 10 }\ncoordinates: [x, y]\npoints: { O: [0, 0], P: [x, y] }\nbodies: { bob: { mass: m, at: P } }\ngravity: [0, -g]\nconstraints: { rod: sqrt(x^2 + y^2) - l }\nspeeds: { u: x*y_dot - y*x_dot }\ninitial: { x: l, u: 0.5 }\n",
+    );
+    let out = eomgen(&["reduce", pendulum.as_str(), "--keep", "y"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{err}");
+    assert!(err.contains("does not rewrite `speeds:`"), "{err}");
+}

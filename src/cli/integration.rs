@@ -266,7 +266,7 @@ fn inconsistent_message(
         )
     } else {
         format!(
-            "the initial state of `{model}` violates its constraints: `{constraint}` has a residual of {residual:.3e}; fix the values, or in the rates mark the dependent coordinates as `{{ guess: … }}` in `initial:` (in generalized speeds, give the speeds: the auxiliary speeds of the non-holonomic rows then start at 0)",
+            "the initial state of `{model}` violates its constraints: `{constraint}` has a residual of {residual:.3e}; fix the values, or in the rates mark the dependent coordinates as `{{ guess: … }}` in `initial:` (in generalized speeds, give the speeds, and coordinates on the holonomic constraints: the auxiliary speeds then start at 0)",
             residual = num(residual)
         )
     }

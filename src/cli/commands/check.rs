@@ -118,7 +118,7 @@ fn print_report(r: &CheckReport) {
         );
         if !c.passed() {
             outln!(
-                "     correct `initial:`, or in the rates mark the dependent coordinates as `{{ guess: … }}` to have them solved from the constraints (in generalized speeds, give the speeds: the auxiliary speeds start at 0)"
+                "     correct `initial:`, or in the rates mark the dependent coordinates as `{{ guess: … }}` to have them solved from the constraints (in generalized speeds, give the speeds, and coordinates on the holonomic constraints: the auxiliary speeds start at 0)"
             );
         }
     }

@@ -600,13 +600,21 @@ fn sample_states(
     let rate_slots: Vec<usize> = (0..n)
         .map(|i| model.coordinate_symbols(i)[1].index())
         .collect();
+    // In speeds beside constraints, the auxiliary speeds (the last ones) are drawn at 0, on
+    // the velocity constraints as every motion is (so the constraint forces do no work), and
+    // every derivation goes through the KKT system: `M` may be singular along an auxiliary
+    // speed (Euler parameters' norm), where rounding would leave a tiny pivot.
+    let auxiliary = model.speeds.as_ref().map_or(0, |s| s.auxiliary);
     let mut sampled = SampledStates {
         drawn: states,
         ..SampledStates::default()
     };
     for _ in 0..states {
         let t = rng.random_range(0.0..5.0);
-        let bindings = draw_bindings(&mut rng, &symbols, &defaults, &state_box, t);
+        let mut bindings = draw_bindings(&mut rng, &symbols, &defaults, &state_box, t);
+        for &slot in &rate_slots[n - auxiliary..] {
+            bindings[slot] = 0.0;
+        }
         evaluator.eval_into(&bindings, &mut v);
         let nn = n * n;
         if !v[..nn + n].iter().all(|x| x.is_finite()) {
@@ -625,7 +633,8 @@ fn sample_states(
         };
         let others_regular =
             (0..others.len()).all(|k| regular(lagrange_len + k * (nn + n)).is_some());
-        let unconstrained = regular(0).filter(|_| constraints.is_none() || others_regular);
+        let unconstrained =
+            regular(0).filter(|_| constraints.is_none() || (others_regular && auxiliary == 0));
         let qdd = match (unconstrained, constraints) {
             (Some(qdd), _) => {
                 compare_others(&v, &qdd, (lagrange_len, n), &mut row_rel, &mut max_rel);

@@ -62,7 +62,7 @@ pub fn energy_routes_skipped(model: &SymbolicModel) -> Option<&'static str> {
         )
     } else if model.speeds_hide_the_energy_form() {
         Some(
-            "energy and power routes skipped: a generalized speed (or a non-holonomic constraint's auxiliary speed, A q̇ + b) has an offset Z(q, t) or a coefficient that depends on t (u = Y q̇ + Z), so T in the speeds shows neither its degree in q̇ nor its dependence on t",
+            "energy and power routes skipped: a generalized speed (or a constraint's auxiliary speed, A q̇ + b) has an offset Z(q, t) or a coefficient that depends on t (u = Y q̇ + Z), so T in the speeds shows neither its degree in q̇ nor its dependence on t",
         )
     } else if model.arena.depends_on(model.kinetic, t) || model.arena.depends_on(model.potential, t)
     {

@@ -479,6 +479,11 @@ fn unsupported(file: &ModelFile) -> Result<(), ReduceError> {
     if !file.frames.is_empty() {
         return feature("`frames:`");
     }
+    // (Its `initial:` and state are in the speeds, which the eliminated constraints' auxiliary
+    // speeds complete: eliminate in the rates.)
+    if !file.speeds.is_empty() {
+        return feature("`speeds:`");
+    }
     if file
         .points
         .iter()

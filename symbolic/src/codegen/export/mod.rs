@@ -495,10 +495,15 @@ impl<'a> Exported<'a> {
             }
         }
         if m > 0 {
-            lines.push(
-                "rhs integrates the index-1 system: the constraints drift by each step's error, as under any such integration (eomgen projects or stabilises them)."
-                    .to_string(),
-            );
+            // (Projection steps along dPhi/dq, which a model in speeds does not export.)
+            lines.push(format!(
+                "rhs integrates the index-1 system: the constraints drift by each step's error, as under any such integration (eomgen {} them).",
+                if self.speeds.is_empty() {
+                    "projects or stabilises"
+                } else {
+                    "stabilises"
+                }
+            ));
         }
         if !self.points.is_empty() {
             lines.push(format!(
@@ -532,7 +537,7 @@ impl<'a> Exported<'a> {
                 "  rhs(t, y, p): dy/dt = [q'; u'] ({}), q' from coordinate_rates, u' {}",
                 2 * n,
                 if m > 0 {
-                    "from the constraints' index-1 system (J over the speeds: each non-holonomic row's auxiliary speed held at 0)"
+                    "from the constraints' index-1 system (J over the speeds: each constraint row's auxiliary speed held at 0)"
                 } else {
                     "from M u' = F"
                 }

@@ -86,7 +86,7 @@ pub fn check_model(
         &mut notes,
     );
     let power_balance = if model.speeds_hide_the_energy_form() {
-        notes.push("power balance skipped: a generalized speed (or a non-holonomic constraint's auxiliary speed, A q̇ + b) has an offset Z(q, t) or a coefficient that depends on t (u = Y q̇ + Z), so T in the speeds shows neither its degree in q̇ nor its dependence on t".to_string());
+        notes.push("power balance skipped: a generalized speed (or a constraint's auxiliary speed, A q̇ + b) has an offset Z(q, t) or a coefficient that depends on t (u = Y q̇ + Z), so T in the speeds shows neither its degree in q̇ nor its dependence on t".to_string());
         None
     } else if explicit_time {
         notes.push("power balance skipped: T or V depends explicitly on t".to_string());
