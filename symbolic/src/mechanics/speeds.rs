@@ -205,7 +205,7 @@ pub(crate) fn switch(
                 (file.constraint_names().iter())
                     .find(|k| k.value == *name)
                     .map(|k| k.location)
-                    .unwrap_or(file.speeds[0].name.location),
+                    .unwrap_or_default(),
                 "rename the constraint: with `speeds`, each constraint row is an auxiliary speed of its name",
             ),
         };
