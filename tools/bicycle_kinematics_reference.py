@@ -27,6 +27,35 @@ import sympy as sp
 from sympy.physics import mechanics as me
 
 
+def kinematics_pairs(listing, N, frames, points, coordinates, rates):
+    """Every vector of `eomgen kinematics --partial --json` beside SymPy's: a list of (what,
+    eomgen's components as text, SymPy's components), for the frames `frames` and points
+    `points` of a model whose ground frame is `N` and whose rates are `rates` (shared with
+    python/tests/test_kinematics.py). Fails if the listing names other frames or points."""
+    pairs = []  # (what, eomgen's components, SymPy's components)
+    for f in listing["frames"]:
+        F = frames[f["name"]]
+        w = F.ang_vel_in(N)
+        pairs.append((f"omega {f['name']}", f["angular_velocity"], w.to_matrix(F)))
+        pairs.append((f"omega {f['name']} in N", f["angular_velocity_ground"], w.to_matrix(N)))
+        pairs.append((f"alpha {f['name']}", f["angular_acceleration"], F.ang_acc_in(N).to_matrix(F)))
+        partials = me.partial_velocity([w], rates, N)[0]
+        for c, mine, theirs in zip(coordinates, f["partial_angular_velocities"], partials):
+            pairs.append((f"d omega {f['name']}/d {c}_dot", mine, theirs.to_matrix(F)))
+    assert {f["name"] for f in listing["frames"]} == set(frames)
+    for pt in listing["points"]:
+        r = points[pt["name"]]
+        v = r.dt(N)
+        pairs.append((f"r {pt['name']}", pt["position"], r.to_matrix(N)))
+        pairs.append((f"v {pt['name']}", pt["velocity"], v.to_matrix(N)))
+        pairs.append((f"a {pt['name']}", pt["acceleration"], v.dt(N).to_matrix(N)))
+        partials = me.partial_velocity([v], rates, N)[0]
+        for c, mine, theirs in zip(coordinates, pt["partial_velocities"], partials):
+            pairs.append((f"d v {pt['name']}/d {c}_dot", mine, theirs.to_matrix(N)))
+    assert {p["name"] for p in listing["points"]} == set(points)
+    return pairs
+
+
 def bicycle(q, p):
     """The model file's frames and points in SymPy: `(N, frames, points)`."""
     N = me.ReferenceFrame("N")
@@ -81,27 +110,7 @@ def main():
     names = {str(s): s for s in plain.values()} | dict(params)
     names["t"] = sp.Symbol("t")
     rates = [q[c].diff(t) for c in coordinates]
-    pairs = []  # (what, eomgen's components, SymPy's components)
-    for f in listing["frames"]:
-        F = frames[f["name"]]
-        w = F.ang_vel_in(N)
-        pairs.append((f"omega {f['name']}", f["angular_velocity"], w.to_matrix(F)))
-        pairs.append((f"omega {f['name']} in N", f["angular_velocity_ground"], w.to_matrix(N)))
-        pairs.append((f"alpha {f['name']}", f["angular_acceleration"], F.ang_acc_in(N).to_matrix(F)))
-        partials = me.partial_velocity([w], rates, N)[0]
-        for c, mine, theirs in zip(coordinates, f["partial_angular_velocities"], partials):
-            pairs.append((f"d omega {f['name']}/d {c}_dot", mine, theirs.to_matrix(F)))
-    assert {f["name"] for f in listing["frames"]} == set(frames)
-    for pt in listing["points"]:
-        r = points[pt["name"]]
-        v = r.dt(N)
-        pairs.append((f"r {pt['name']}", pt["position"], r.to_matrix(N)))
-        pairs.append((f"v {pt['name']}", pt["velocity"], v.to_matrix(N)))
-        pairs.append((f"a {pt['name']}", pt["acceleration"], v.dt(N).to_matrix(N)))
-        partials = me.partial_velocity([v], rates, N)[0]
-        for c, mine, theirs in zip(coordinates, pt["partial_velocities"], partials):
-            pairs.append((f"d v {pt['name']}/d {c}_dot", mine, theirs.to_matrix(N)))
-    assert {p["name"] for p in listing["points"]} == set(points)
+    pairs = kinematics_pairs(listing, N, frames, points, coordinates, rates)
     skipped = [w for w, mine, _ in pairs if any(e.startswith("[not printed") for e in mine)]
     pairs = [pair for pair in pairs if pair[0] not in skipped]
     # `lambda` (the head angle) is a Python keyword: parsed under another name.

@@ -7,6 +7,8 @@ as SymPy writes them, and compared at random states to 1e-12 (relative to each v
 size)."""
 
 import json
+import pathlib
+import sys
 
 import numpy as np
 import pytest
@@ -15,6 +17,9 @@ import eomgen
 
 sp = pytest.importorskip("sympy")
 me = pytest.importorskip("sympy.physics.mechanics")
+# The pairs of vectors compared, shared with tools/bicycle_kinematics_reference.py.
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[2] / "tools"))
+from bicycle_kinematics_reference import kinematics_pairs  # noqa: E402
 
 
 def _heavy_top(q, p):
@@ -91,27 +96,7 @@ def test_kinematics_equal_sympys(name):
         return sp.parse_expr(text.replace("^", "**"), local_dict=names)
 
     rates = [q[c].diff(t) for c in coordinates]
-    pairs = []  # (what, eomgen's components, SymPy's components)
-    for f in listing["frames"]:
-        F = frames[f["name"]]
-        w = F.ang_vel_in(N)
-        pairs.append((f"omega {f['name']}", f["angular_velocity"], w.to_matrix(F)))
-        pairs.append((f"omega {f['name']} in N", f["angular_velocity_ground"], w.to_matrix(N)))
-        pairs.append((f"alpha {f['name']}", f["angular_acceleration"], F.ang_acc_in(N).to_matrix(F)))
-        partials = me.partial_velocity([w], rates, N)[0]
-        for c, mine, theirs in zip(coordinates, f["partial_angular_velocities"], partials):
-            pairs.append((f"d omega {f['name']}/d {c}_dot", mine, theirs.to_matrix(F)))
-    assert {f["name"] for f in listing["frames"]} == set(frames)
-    for pt in listing["points"]:
-        r = points[pt["name"]]
-        v = r.dt(N)
-        pairs.append((f"r {pt['name']}", pt["position"], r.to_matrix(N)))
-        pairs.append((f"v {pt['name']}", pt["velocity"], v.to_matrix(N)))
-        pairs.append((f"a {pt['name']}", pt["acceleration"], v.dt(N).to_matrix(N)))
-        partials = me.partial_velocity([v], rates, N)[0]
-        for c, mine, theirs in zip(coordinates, pt["partial_velocities"], partials):
-            pairs.append((f"d v {pt['name']}/d {c}_dot", mine, theirs.to_matrix(N)))
-    assert {p["name"] for p in listing["points"]} == set(points)
+    pairs = kinematics_pairs(listing, N, frames, points, coordinates, rates)
     symbols = sorted(names.values(), key=str)
     rng = np.random.default_rng(7)
     for _ in range(3):
