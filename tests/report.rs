@@ -2,9 +2,7 @@
 //! pass, a file with wrong reference values fails (so the checks can fail), the MathML of a
 //! known equation has the expected structure, the output is byte-identical across runs, and
 //! `simulate` draws the phase portrait and the energy drift. The full report on every bundled
-//! model runs too: about 18 s in a debug build, most of it `braking_car_side`'s default run
-//! (its 7.5 s at rest after the stop, at rtol 1e-12, take 29,000 evaluations, each solving the
-//! redundant contacts of both wheels stuck by a singular value decomposition).
+//! model runs too: about 6 s in a debug build.
 
 use crate::common;
 use common::{eomgen, eomgen_ok};
