@@ -15,7 +15,7 @@
 //!
 //! The matrix is assembled from the model's functions at each evaluation (`M`, `F`, `J`, `γ`,
 //! `G`, `γ_c`) and solved by LU, or through the Schur complement where held rows repeat each
-//! other ([`solve_held`]): a phase is where a ball rests or a foot stands, not where the work
+//! other ([`HeldEquations::solve`]): a phase is where a ball rests or a foot stands, not where the work
 //! of a run is spent.
 //!
 //! Also here, what a phase starts and ends with: which contacts start closed ([`touching`]),
@@ -133,7 +133,15 @@ impl<'m> ContactPhase<'m> {
             }
             b[m + r] = gamma;
         }
-        let solution = solve_held(&mass, &forcing, &held, &pushes, &b)
+        let equations = HeldEquations {
+            mass: &mass,
+            forcing: &forcing,
+            held: &held,
+            pushes: &pushes,
+            b: &b,
+        };
+        let solution = equations
+            .solve()
             .ok_or(RhsError::SingularConstraintMatrix)?;
         let accelerations = solution.rows(0, n).iter().copied().collect();
         let mut forces = vec![(0.0, 0.0); self.closed.len()];
@@ -210,72 +218,73 @@ impl<'m> ContactPhase<'m> {
     }
 }
 
-/// `[q̈; λ]` (`n + k`) of `M q̈ + Pᵀ λ = F`, `A q̈ = b`: `mass` `M` and `forcing` `F` (`n`), the
-/// held rows `held` `A` and the directions they push along `pushes` `P` (both `k × n`), and
-/// `b` (`k`). `None` if no solution is found.
-///
-/// By LU of the whole matrix `[M Pᵀ; A 0]` when its pivots are all above 1e-12 of its largest
-/// entry. Rows that repeat each other (a box standing, sticking, on two feet: their slips'
-/// rows are equal) leave that matrix singular but the equations consistent: `q̈` is still
-/// unique, and the multipliers are taken of least norm (an even share). Then `λ` solves the
-/// Schur complement `A M⁻¹ Pᵀ λ = A M⁻¹ F − b` by SVD (least norm, singular values below
-/// 1e-12 of its largest entry dropped) and `q̈ = M⁻¹ (F − Pᵀ λ)`, with `M` by Cholesky. An SVD
-/// of the whole matrix instead, whose small singular values are those of `M` over those of
-/// `A M⁻¹ Aᵀ` (1e-7 of its largest for a braking car at rest), loses that ratio: `q̈` came
-/// out with noise of 1e-10 m/s² from one evaluation to the next, which held DOP853 at 1e-12
-/// to steps of 4 ms for a car at rest. Last, if `M` is not positive definite, that SVD.
-fn solve_held(
-    mass: &DMatrix<f64>,
-    forcing: &DVector<f64>,
-    held: &DMatrix<f64>,
-    pushes: &DMatrix<f64>,
-    b: &DVector<f64>,
-) -> Option<DVector<f64>> {
-    let (n, k) = (mass.nrows(), held.nrows());
-    let mut matrix = DMatrix::<f64>::zeros(n + k, n + k);
-    matrix.view_mut((0, 0), (n, n)).copy_from(mass);
-    matrix.view_mut((n, 0), (k, n)).copy_from(held);
-    matrix
-        .view_mut((0, n), (n, k))
-        .copy_from(&pushes.transpose());
-    let mut rhs = DVector::<f64>::zeros(n + k);
-    rhs.rows_mut(0, n).copy_from(forcing);
-    rhs.rows_mut(n, k).copy_from(b);
-    let scale = matrix.amax().max(f64::MIN_POSITIVE);
-    let lu = matrix.clone().lu();
-    let pivots_fine = (0..n + k).all(|i| lu.u()[(i, i)].abs() > 1e-12 * scale);
-    let solution = if pivots_fine { lu.solve(&rhs) } else { None }
-        .or_else(|| by_schur_complement(mass, forcing, held, pushes, b))
-        .or_else(|| matrix.svd(true, true).solve(&rhs, 1e-12 * scale).ok())?;
-    solution.iter().all(|v| v.is_finite()).then_some(solution)
+/// The equations of a phase at one state: `M q̈ + Pᵀ λ = F`, `A q̈ = b`.
+struct HeldEquations<'a> {
+    /// `M` (`n × n`).
+    mass: &'a DMatrix<f64>,
+    /// `F` (`n`).
+    forcing: &'a DVector<f64>,
+    /// The held rows `A` (`k × n`).
+    held: &'a DMatrix<f64>,
+    /// The directions the multipliers push along, `P` (`k × n`).
+    pushes: &'a DMatrix<f64>,
+    /// `b` (`k`).
+    b: &'a DVector<f64>,
 }
 
-/// [`solve_held`]'s least-norm solution through the Schur complement `A M⁻¹ Pᵀ`; `None` if `M`
-/// is not positive definite.
-fn by_schur_complement(
-    mass: &DMatrix<f64>,
-    forcing: &DVector<f64>,
-    held: &DMatrix<f64>,
-    pushes: &DMatrix<f64>,
-    b: &DVector<f64>,
-) -> Option<DVector<f64>> {
-    let cholesky = mass.clone().cholesky()?;
-    let inverse_mass_pushes = cholesky.solve(&pushes.transpose());
-    let free = cholesky.solve(forcing);
-    let schur = held * &inverse_mass_pushes;
-    let scale = schur.amax().max(f64::MIN_POSITIVE);
-    let multipliers = (schur.svd(true, true))
-        .solve(&(held * &free - b), 1e-12 * scale)
-        .ok()?;
-    let accelerations = free - inverse_mass_pushes * &multipliers;
-    let (n, k) = (mass.nrows(), held.nrows());
-    Some(DVector::from_fn(n + k, |i, _| {
-        if i < n {
-            accelerations[i]
-        } else {
-            multipliers[i - n]
-        }
-    }))
+impl HeldEquations<'_> {
+    /// `[q̈; λ]` (`n + k`) of `M q̈ + Pᵀ λ = F`, `A q̈ = b`; `None` if no solution is found.
+    ///
+    /// By LU of the whole matrix `[M Pᵀ; A 0]` when its pivots are all above 1e-12 of its largest
+    /// entry. Rows that repeat each other (a box standing, sticking, on two feet: their slips'
+    /// rows are equal) leave that matrix singular but the equations consistent: `q̈` is still
+    /// unique, and the multipliers are taken of least norm (an even share). Then `λ` solves the
+    /// Schur complement `A M⁻¹ Pᵀ λ = A M⁻¹ F − b` by SVD (least norm, singular values below
+    /// 1e-12 of its largest entry dropped) and `q̈ = M⁻¹ (F − Pᵀ λ)`, with `M` by Cholesky. An SVD
+    /// of the whole matrix instead, whose small singular values are those of `M` over those of
+    /// `A M⁻¹ Aᵀ` (1e-7 of its largest for a braking car at rest), loses that ratio: `q̈` came
+    /// out with noise of 1e-10 m/s² from one evaluation to the next, which held DOP853 at 1e-12
+    /// to steps of 4 ms for a car at rest. Last, if `M` is not positive definite, that SVD.
+    fn solve(&self) -> Option<DVector<f64>> {
+        let (n, k) = (self.mass.nrows(), self.held.nrows());
+        let mut matrix = DMatrix::<f64>::zeros(n + k, n + k);
+        matrix.view_mut((0, 0), (n, n)).copy_from(self.mass);
+        matrix.view_mut((n, 0), (k, n)).copy_from(self.held);
+        (matrix.view_mut((0, n), (n, k))).copy_from(&self.pushes.transpose());
+        let mut rhs = DVector::<f64>::zeros(n + k);
+        rhs.rows_mut(0, n).copy_from(self.forcing);
+        rhs.rows_mut(n, k).copy_from(self.b);
+        let scale = matrix.amax().max(f64::MIN_POSITIVE);
+        let lu = matrix.clone().lu();
+        let pivots_fine = (0..n + k).all(|i| lu.u()[(i, i)].abs() > 1e-12 * scale);
+        let solution = if pivots_fine { lu.solve(&rhs) } else { None }
+            .or_else(|| self.by_schur_complement())
+            .or_else(|| matrix.svd(true, true).solve(&rhs, 1e-12 * scale).ok())?;
+        solution.iter().all(|v| v.is_finite()).then_some(solution)
+    }
+
+    /// [`Self::solve`]'s least-norm solution through the Schur complement `A M⁻¹ Pᵀ`; `None`
+    /// if `M` is not positive definite.
+    fn by_schur_complement(&self) -> Option<DVector<f64>> {
+        let cholesky = self.mass.clone().cholesky()?;
+        let inverse_mass_pushes = cholesky.solve(&self.pushes.transpose());
+        let free = cholesky.solve(self.forcing);
+        let schur = self.held * &inverse_mass_pushes;
+        let scale = schur.amax().max(f64::MIN_POSITIVE);
+        let multipliers = (schur.svd(true, true))
+            .solve(&(self.held * &free - self.b), 1e-12 * scale)
+            .ok()?;
+        let accelerations = free - inverse_mass_pushes * &multipliers;
+        let n = self.mass.nrows();
+        let k = self.held.nrows();
+        Some(DVector::from_fn(n + k, |i, _| {
+            if i < n {
+                accelerations[i]
+            } else {
+                multipliers[i - n]
+            }
+        }))
+    }
 }
 
 /// With no contact closed, the model's own first-order form (the same steps and bits as a
@@ -541,7 +550,14 @@ mod tests {
                 ],
             );
             let rates = DVector::zeros(4);
-            let x = solve_held(&mass, &forcing, &held, &held, &rates).unwrap();
+            let equations = HeldEquations {
+                mass: &mass,
+                forcing: &forcing,
+                held: &held,
+                pushes: &held,
+                b: &rates,
+            };
+            let x = equations.solve().unwrap();
             // q̈ to rounding of g (the whole matrix's SVD left 1e-10 m/s² here).
             for i in 0..3 {
                 assert!(
