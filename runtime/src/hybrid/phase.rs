@@ -14,9 +14,9 @@
 //! §7.2: the transition from contact to separation).
 //!
 //! The matrix is assembled from the model's functions at each evaluation (`M`, `F`, `J`, `γ`,
-//! `G`, `γ_c`) and solved by LU, or through the Schur complement where held rows repeat each
-//! other ([`HeldEquations::solve`]): a phase is where a ball rests or a foot stands, not where the work
-//! of a run is spent.
+//! `G`, `γ_c`) and solved by LU, or through the Schur complement where held rows repeat
+//! each other ([`HeldEquations::solve`]): a phase is where a ball rests or a foot stands,
+//! not where the work of a run is spent.
 //!
 //! Also here, what a phase starts and ends with: which contacts start closed ([`touching`]),
 //! how a closing contact is held ([`closing_hold`]), and the contacts' event functions
@@ -87,8 +87,8 @@ impl<'m> ContactPhase<'m> {
     /// of [`Self::closed`]) at `(t, y)`.
     ///
     /// # Errors
-    /// [`RhsError::SingularConstraintMatrix`] if the matrix is singular (contacts that
-    /// repeat each other or the model's constraints).
+    /// [`RhsError::SingularConstraintMatrix`] if no finite solution is found (rows that repeat
+    /// each other are solved, [`HeldEquations::solve`]).
     pub(crate) fn solve(
         &self,
         t: f64,
@@ -240,11 +240,13 @@ impl HeldEquations<'_> {
     /// rows are equal) leave that matrix singular but the equations consistent: `q̈` is still
     /// unique, and the multipliers are taken of least norm (an even share). Then `λ` solves the
     /// Schur complement `A M⁻¹ Pᵀ λ = A M⁻¹ F − b` by SVD (least norm, singular values below
-    /// 1e-12 of its largest entry dropped) and `q̈ = M⁻¹ (F − Pᵀ λ)`, with `M` by Cholesky. An SVD
-    /// of the whole matrix instead, whose small singular values are those of `M` over those of
-    /// `A M⁻¹ Aᵀ` (1e-7 of its largest for a braking car at rest), loses that ratio: `q̈` came
-    /// out with noise of 1e-10 m/s² from one evaluation to the next, which held DOP853 at 1e-12
-    /// to steps of 4 ms for a car at rest. Last, if `M` is not positive definite, that SVD.
+    /// 1e-12 of its largest entry dropped) and `q̈ = M⁻¹ (F − Pᵀ λ)`, with `M` by Cholesky (`q̈`
+    /// is unique where `P = A`; a sliding contact's `P ≠ A`). An SVD of the whole matrix
+    /// instead, whose smallest kept singular values (about those of `A M⁻¹ Aᵀ`) are 3e-7 of its
+    /// largest (`M`'s) for a braking car at rest, loses that ratio: `q̈` came out with noise of
+    /// 1e-10 m/s² from one evaluation to the next, which held DOP853 at 1e-12 to steps of 4 ms
+    /// for a car at rest. Last, if `M` is not positive definite or the Schur complement's
+    /// solution is not finite, that SVD.
     fn solve(&self) -> Option<DVector<f64>> {
         let (n, k) = (self.mass.nrows(), self.held.nrows());
         let mut matrix = DMatrix::<f64>::zeros(n + k, n + k);
@@ -257,18 +259,24 @@ impl HeldEquations<'_> {
         let scale = matrix.amax().max(f64::MIN_POSITIVE);
         let lu = matrix.clone().lu();
         let pivots_fine = (0..n + k).all(|i| lu.u()[(i, i)].abs() > 1e-12 * scale);
-        let solution = if pivots_fine { lu.solve(&rhs) } else { None }
-            .or_else(|| self.by_schur_complement())
-            .or_else(|| matrix.svd(true, true).solve(&rhs, 1e-12 * scale).ok())?;
-        solution.iter().all(|v| v.is_finite()).then_some(solution)
+        let finite = |x: &DVector<f64>| x.iter().all(|v| v.is_finite());
+        if pivots_fine {
+            return lu.solve(&rhs).filter(finite);
+        }
+        (self.by_schur_complement().filter(finite))
+            .or_else(|| matrix.svd(true, true).solve(&rhs, 1e-12 * scale).ok())
+            .filter(finite)
     }
 
     /// [`Self::solve`]'s least-norm solution through the Schur complement `A M⁻¹ Pᵀ`; `None`
     /// if `M` is not positive definite.
     fn by_schur_complement(&self) -> Option<DVector<f64>> {
         let cholesky = self.mass.clone().cholesky()?;
-        let inverse_mass_pushes = cholesky.solve(&self.pushes.transpose());
         let free = cholesky.solve(self.forcing);
+        if self.held.nrows() == 0 {
+            return Some(free);
+        }
+        let inverse_mass_pushes = cholesky.solve(&self.pushes.transpose());
         let schur = self.held * &inverse_mass_pushes;
         let scale = schur.amax().max(f64::MIN_POSITIVE);
         let multipliers = (schur.svd(true, true))
@@ -518,17 +526,19 @@ mod tests {
     use super::*;
 
     /// A braking car at rest on both wheels, stuck (HW16's model, `braking_car_side`): `q =
-    /// (x, y, θ)`, four held rows for three coordinates, the two slips' rows equal. Statics
-    /// give the loads `N_F = m g b / (a + b)`, `N_R = m g a / (a + b)`, `q̈ = 0`, and no
-    /// tangential force, shared evenly (least norm) as 0 and 0.
+    /// (x, y, θ)`, four held rows for three coordinates (at `θ = 0` the two slips' rows are
+    /// equal). Pushed along the road by `F_x` or not, at `θ = 0` and `1e-3`: `q̈ = 0` to
+    /// rounding of `g`, the multipliers balance `F` (`Aᵀ λ = F`) and are of least norm (`λ`
+    /// orthogonal to `Aᵀ`'s null vector). At `θ = 0` statics give the loads `N_F = m g b / (a
+    /// + b)`, `N_R = m g a / (a + b)` without `F_x`, and the two slips share `F_x` evenly.
     #[test]
-    fn repeated_rows_give_the_static_loads_and_no_acceleration() {
+    fn repeated_rows_give_the_static_forces_and_no_acceleration() {
         let (m, inertia, a, b, h, g) = (1500.0, 2500.0, 1.2, 1.4, 0.55, 9.81);
-        // Rounding-size angles, as a run at rest leaves them.
-        for theta in [0.0, 2.1e-17, -1.7e-17] {
+        let weight = m * g;
+        for (theta, push) in [(0.0, 0.0), (0.0, -3000.0), (1e-3, 0.0), (1e-3, -3000.0)] {
             let (s, c) = f64::sin_cos(theta);
             let mass = DMatrix::from_diagonal(&DVector::from_vec(vec![m, m, inertia]));
-            let forcing = DVector::from_vec(vec![0.0, -m * g, 0.0]);
+            let forcing = DVector::from_vec(vec![push, -weight, 0.0]);
             // Front normal, front slip, rear normal, rear slip: the gradients of the contact
             // points' heights and positions along the road.
             let held = DMatrix::from_row_slice(
@@ -549,31 +559,65 @@ mod tests {
                     b * s + h * c,
                 ],
             );
-            let rates = DVector::zeros(4);
             let equations = HeldEquations {
                 mass: &mass,
                 forcing: &forcing,
                 held: &held,
                 pushes: &held,
-                b: &rates,
+                b: &DVector::zeros(4),
             };
             let x = equations.solve().unwrap();
+            let case = format!("θ = {theta:e}, F_x = {push}");
             // q̈ to rounding of g (the whole matrix's SVD left 1e-10 m/s² here).
             for i in 0..3 {
-                assert!(
-                    x[i].abs() < 1e-14 * g,
-                    "q̈[{i}] = {:e} at θ = {theta:e}",
-                    x[i]
-                );
+                assert!(x[i].abs() < 1e-14 * g, "q̈[{i}] = {:e}, {case}", x[i]);
             }
-            let weight = m * g;
-            let front = weight * b / (a + b);
-            let rear = weight * a / (a + b);
-            // The multipliers are minus the forces (`M q̈ + Aᵀ λ = F`).
-            assert!((-x[3] - front).abs() < 1e-12 * weight, "N_F = {}", -x[3]);
-            assert!((-x[5] - rear).abs() < 1e-12 * weight, "N_R = {}", -x[5]);
-            assert!(x[4].abs() < 1e-12 * weight && x[6].abs() < 1e-12 * weight);
-            assert!((x[4] - x[6]).abs() < 1e-12 * weight, "an even share");
+            let multipliers = x.rows(3, 4).into_owned();
+            let balance = held.transpose() * &multipliers - &forcing;
+            assert!(
+                balance.amax() < 1e-12 * weight,
+                "Aᵀλ − F = {balance}, {case}"
+            );
+            // Aᵀ's null vector: the signed 3 × 3 minors of `A` without each row.
+            let null = DVector::from_fn(4, |i, _| {
+                let minor = held.clone().remove_row(i);
+                let sign = if i % 2 == 0 { 1.0 } else { -1.0 };
+                sign * minor.fixed_view::<3, 3>(0, 0).determinant()
+            });
+            assert!((held.transpose() * &null).amax() < 1e-12 * null.amax());
+            let along = null.dot(&multipliers) / null.norm();
+            assert!(along.abs() < 1e-12 * weight, "λ·v = {along:e}, {case}");
+            if theta == 0.0 {
+                assert!((x[4] - push / 2.0).abs() < 1e-12 * weight, "{case}");
+                assert!((x[6] - push / 2.0).abs() < 1e-12 * weight, "{case}");
+            }
+            if theta == 0.0 && push == 0.0 {
+                // The multipliers are minus the forces (`M q̈ + Aᵀ λ = F`).
+                let (front, rear) = (weight * b / (a + b), weight * a / (a + b));
+                assert!((-x[3] - front).abs() < 1e-12 * weight, "N_F = {}", -x[3]);
+                assert!((-x[5] - rear).abs() < 1e-12 * weight, "N_R = {}", -x[5]);
+            }
         }
+    }
+
+    /// With no held row (a free phase) and a mass matrix whose LU pivot test fails, the
+    /// Schur complement's path gives `M⁻¹ F`.
+    #[test]
+    fn no_held_row_gives_the_free_motion() {
+        let mass = DMatrix::from_diagonal(&DVector::from_vec(vec![1.0, 1e-13]));
+        let forcing = DVector::from_vec(vec![2.0, 3e-13]);
+        let none = DMatrix::zeros(0, 2);
+        let equations = HeldEquations {
+            mass: &mass,
+            forcing: &forcing,
+            held: &none,
+            pushes: &none,
+            b: &DVector::zeros(0),
+        };
+        let x = equations.solve().unwrap();
+        assert!(
+            (x[0] - 2.0).abs() < 1e-15 && (x[1] - 3.0).abs() < 1e-12,
+            "{x}"
+        );
     }
 }
