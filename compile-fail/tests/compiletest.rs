@@ -2,8 +2,7 @@
 //! must fail to compile with the message recorded in its `.stderr` (`file:line:col`, what is
 //! wrong, what would be right, and rustc's location of the `model!` call). Regenerate with
 //! `TRYBUILD=overwrite cargo test --workspace --test compiletest -- --ignored` and review the diff. The messages
-//! are rustc's rendering of our diagnostics, pinned to the toolchain the project builds with
-//! (in CI, clippy-driver's, which renders them the same: `.ci/run` builds with it).
+//! are rustc's rendering of our diagnostics, pinned to the toolchain the project builds with.
 //!
 //! The cases are the macro's own (`macro-input/`: its argument, a missing file, a broken file)
 //! and one model file of each other category, which shows that the loader's diagnostics reach
