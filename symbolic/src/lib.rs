@@ -7,8 +7,7 @@ pub mod mechanics;
 pub mod model;
 
 /// The bundled models' folder, `models/` at the workspace's root, for the unit tests: found
-/// from the manifest of the package that compiles them (`unit-tests/Cargo.toml`, whose
-/// manifest folder is one level deeper than this crate's).
+/// from the manifest of the package that compiles them (`symbolic-tests/Cargo.toml`).
 #[cfg(test)]
 pub(crate) fn bundled_models_dir() -> std::path::PathBuf {
     std::path::Path::new(env!("CARGO_MANIFEST_DIR"))

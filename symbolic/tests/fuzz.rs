@@ -15,7 +15,7 @@
 //! the full run of 10⁶ is
 //!
 //! ```text
-//! EOMGEN_FUZZ_CASES=1000000 cargo test --release -p eomgen-symbolic --test suite -- fuzz:: --ignored --nocapture
+//! EOMGEN_FUZZ_CASES=1000000 cargo test --release -p eomgen-symbolic-tests --test suite -- fuzz:: --ignored --nocapture
 //! ```
 
 use std::panic::{AssertUnwindSafe, catch_unwind};
