@@ -97,8 +97,9 @@ def test_kinematics_equal_sympys(name):
 
     rates = [q[c].diff(t) for c in coordinates]
     # Parsed and flattened once; each sample then replaces the symbols by numbers
-    # (`xreplace`, which evaluates as it rebuilds, rather than `subs`, which also tries to
-    # simplify: the same numbers, in a fraction of the time).
+    # (`xreplace`, which rebuilds the tree once and evaluates as it goes, rather than `subs`,
+    # which matches subexpressions and rebuilds after each substitution: the same numbers, up
+    # to the order of rounding, in a fraction of the time).
     pairs = [(what, [parse(e) for e in mine], [flat(e) for e in theirs])
              for what, mine, theirs in kinematics_pairs(listing, N, frames, points, coordinates, rates)]
     symbols = sorted(names.values(), key=str)
