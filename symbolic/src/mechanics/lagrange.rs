@@ -178,7 +178,7 @@ mod tests {
     /// less than all compacted.
     #[test]
     fn the_equations_cost_no_more_than_either_uniform_form() {
-        let dir = crate::bundled_models_dir();
+        let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../models");
         let mut cheaper_than_compact = Vec::new();
         let mut entries: Vec<_> = std::fs::read_dir(dir)
             .unwrap()
