@@ -7,7 +7,7 @@
 //! kinematics of its bodies, by Lagrange's equations for one given by its energies
 //! (`eomgen_symbolic::mechanics::preferred_formulation`). The runtime integrates them.
 //!
-//! ```
+//! ```rust,standalone_crate
 //! use eomgen::{DormandPrince54, FirstOrder, Integrator, IntegratorOptions, MechanicalSystem,
 //!              OdeSystem, OutputTimes};
 //!
@@ -69,6 +69,12 @@ pub use floquet_references::{
 mod floquet_references;
 
 /// The README's Rust examples, compiled and run by `cargo test --doc`.
+///
+/// Rustdoc compiles the doctests of this crate into one program; an example that calls
+/// `model!` is marked `standalone_crate` (compiled on its own, about 0.8 processor-seconds
+/// each), since the macro reads its file relative to the invoking source file, which in the
+/// merged program is a temporary file. Merged, the other 21 took one compilation rather than
+/// 21 (2026-11-29: one merge failure made every one of the 24 standalone).
 #[cfg(all(doctest, feature = "jit"))]
 #[doc = include_str!("../README.md")]
 pub struct ReadmeDoctests;
