@@ -2,10 +2,14 @@
 
 use super::*;
 
-fn model(name: &str) -> SymbolicModel {
+/// The text of the bundled model `name` (`models/` beside the package that builds these tests).
+fn source(name: &str) -> String {
     let path = format!("{}/../models/{name}.yaml", env!("CARGO_MANIFEST_DIR"));
-    let source = std::fs::read_to_string(path).unwrap();
-    let file = crate::model::load("m.yaml", &source).unwrap();
+    std::fs::read_to_string(path).unwrap()
+}
+
+fn model(name: &str) -> SymbolicModel {
+    let file = crate::model::load("m.yaml", &source(name)).unwrap();
     SymbolicModel::from_file(&file).unwrap()
 }
 
@@ -30,11 +34,7 @@ fn the_sampled_comparison_sees_a_one_percent_error_in_one_equation() {
 
     // Relative to the size of q̈: with g = 1e6, q̈ ~ 1e6, and the differences of rounding
     // (~1e-10 absolute) between equations and their multiple are still ~1e-16 relative.
-    let path = format!(
-        "{}/../models/double_pendulum.yaml",
-        env!("CARGO_MANIFEST_DIR")
-    );
-    let source = std::fs::read_to_string(path).unwrap();
+    let source = source("double_pendulum");
     let heavy = source.replace("  g: 10.0 ", "  g: 1e6  ");
     assert_ne!(heavy, source);
     let file = crate::model::load("m.yaml", &heavy).unwrap();
@@ -199,11 +199,7 @@ fn integrability_after_holonomic_constraints_and_in_two_coordinates() {
 /// `c (−sin θ ẋ + cos θ ẏ) + ẋ` is at the file's `c = 0` (x = const) and not at c = 1.
 #[test]
 fn integrable_velocity_constraints_are_told_from_a_knife_edge() {
-    let path = format!(
-        "{}/../models/chaplygin_sleigh.yaml",
-        env!("CARGO_MANIFEST_DIR")
-    );
-    let source = std::fs::read_to_string(path).unwrap();
+    let source = source("chaplygin_sleigh");
     let knife = "no_side_slip: -sin(theta)*x_dot + cos(theta)*y_dot";
     assert!(source.contains(knife));
     for (constraint, c, integrable) in [
