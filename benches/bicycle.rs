@@ -34,7 +34,7 @@ use eomgen_symbolic::mechanics::{Jacobians, SymbolicModel, preferred_equations};
 fn bicycle_file() -> PathBuf {
     PathBuf::from(concat!(
         env!("CARGO_MANIFEST_DIR"),
-        "/models/whipple_bicycle.yaml"
+        "/../models/whipple_bicycle.yaml"
     ))
 }
 

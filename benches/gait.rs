@@ -19,7 +19,10 @@ use eomgen::analysis::{GaitOptions, gait, gait_sweep, return_map};
 use eomgen::{DynFirstOrder, JitModel};
 
 fn walker() -> DynFirstOrder<JitModel> {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/models/simplest_walker.yaml");
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../models/simplest_walker.yaml"
+    );
     DynFirstOrder::new(JitModel::load(path).expect("the bundled walker loads"))
 }
 

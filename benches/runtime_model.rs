@@ -59,7 +59,7 @@ const STATE: [f64; 4] = [0.4, 1.9, -0.8, 1.3];
 fn double_pendulum_file() -> PathBuf {
     PathBuf::from(concat!(
         env!("CARGO_MANIFEST_DIR"),
-        "/models/double_pendulum.yaml"
+        "/../models/double_pendulum.yaml"
     ))
 }
 
@@ -264,7 +264,7 @@ fn alternated(_: &mut Criterion) {
         ),
     ];
     for (name, mut other) in others {
-        let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(format!("models/{name}.yaml"));
+        let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(format!("../models/{name}.yaml"));
         let mut run_time = DynFirstOrder::new(JitModel::load(&path).expect("loads"));
         // A state off the initial one, where no rate is zero.
         let y: Vec<f64> = ModelInfo::initial_state(other.as_ref())

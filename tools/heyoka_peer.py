@@ -88,7 +88,7 @@ better on every model. The whole panel takes ~35 s on one core, the 5-link chain
 a different computation from the double-precision runs being measured; the equations are
 checked against eomgen's by `check`.)
 
-Usage (from the repository root; P = the Rust program of examples/work_precision_peers.rs;
+Usage (from the repository root; P = the Rust program of benches/work_precision_peers.rs;
 a Python with heyoka, numpy, sympy, pyyaml, mpmath and the eomgen package):
     python tools/heyoka_peer.py reference --out /tmp/peers-out/reference.json [--models a,b]
     python tools/heyoka_peer.py check [--models a,b] [--states 20] [--binary $P]

@@ -9,7 +9,7 @@ same orders (checked), so the time per step compares their recurrences and step 
 expression, and the time per step above the baseline's is the operation's own cost:
 
 - eomgen: the model file `coordinates: [x]`, `kinetic: x_dot^2/2`, `generalized_forces: {x:
-  -x + g}`, loaded and compiled at run time (examples/work_precision_peers.rs `--from-file
+  -x + g}`, loaded and compiled at run time (benches/work_precision_peers.rs `--from-file
   on`: the command line's path), `--methods taylor`, every step recorded;
 - heyoka: `taylor_adaptive([(x, v), (v, -x + g)], tol=tol)`, `propagate_until(20)` (the
   expression converted from the same text by SymPy, as tools/heyoka_peer.py converts a
@@ -18,7 +18,7 @@ expression, and the time per step above the baseline's is the operation's own co
 Times are medians over `--rounds` rounds (the two codes alternated) of the medians of `--reps`
 runs. Usage (from the repository root, with heyoka, sympy and the eomgen package installed):
 
-    cargo build --release --no-default-features --features jit --example work_precision_peers
+    cargo build --release -p eomgen-benches --features peers --example work_precision_peers
     python tools/taylor_ops_bench.py [--tols 1e-6,1e-9,1e-12] [--rounds 5] [--reps 21] [--out ops.md]
 """
 import argparse

@@ -4,7 +4,7 @@ Codes compared, on the same model, initial state and reference:
 - eomgen's adaptive methods, by their `Method` names (`--methods dp54,dop853`; methods added
   later are included by name), and ode_solvers 0.6.2's Dop853 (`--peers
   ode_solvers-dop853`, optionally `ode_solvers-dopri5`), both measured by the Rust program of
-  examples/work_precision_peers.rs on the model loaded from its file and compiled at run
+  benches/work_precision_peers.rs on the model loaded from its file and compiled at run
   time, the command line's path (build the example with `--features jit`), or with
   `--compiled` on the copy `model!` compiled into the program (the double pendulum and the
   figure eight only);
@@ -43,7 +43,7 @@ first table gives that ratio per model and target, and a verdict.
 
 Usage (from the repository root; the driver and heyoka_peer need a Python with heyoka, sympy,
 pyyaml, matplotlib and the eomgen package):
-    cargo build --release --no-default-features --features jit --example work_precision_peers
+    cargo build --release -p eomgen-benches --features peers --example work_precision_peers
     python tools/work_precision_peers.py --binary target/release/examples/work_precision_peers \
         [--models double_pendulum,kepler_e09] [--compiled] [--methods dp54,dop853,vern9,taylor] \
         [--peers ode_solvers-dop853] [--rounds 5] [--reps 3] [--per-decade 2] \

@@ -1,11 +1,11 @@
 //! The Rust side of the work–precision comparison with peer codes: eomgen's integration
-//! methods (by their [`Method`] names) and the peer crate `ode_solvers` (0.6.2, a
-//! dev-dependency) on the same compiled model, one JSON line per run on stdout.
+//! methods (by their [`Method`] names) and the peer crate `ode_solvers` (0.6.2) on the same
+//! compiled model, one JSON line per run on stdout.
 //! `tools/work_precision_peers.py` runs this program in alternating rounds with
 //! `tools/heyoka_peer.py` and builds the tables and the chart.
 //!
 //! ```sh
-//! cargo build --release --no-default-features --example work_precision_peers
+//! cargo build --release -p eomgen-benches --features peers --example work_precision_peers
 //! P=target/release/examples/work_precision_peers
 //! $P initial --model double_pendulum            # y(0) as JSON (shortest round-trip digits)
 //! $P rhs --model double_pendulum --state 0.1,0.2,0.3,0.4   # F(0, y) as JSON
@@ -13,7 +13,7 @@
 //!     --tols 1e-2,1e-3,1e-4 --reps 5 [--reference reference.json] [--host-features off]
 //! ```
 //!
-//! With `--from-file on` (a build with `--features jit`), eomgen's side and ode_solvers'
+//! With `--from-file on`, eomgen's side and ode_solvers'
 //! run the model loaded from its file and compiled at run time by Cranelift, the path of the
 //! command line and of Python, instead of the copy `model!` compiled into this program.
 //!
@@ -474,14 +474,13 @@ fn main_inner() -> Result<(), String> {
 }
 
 /// The subcommand on the model loaded from its file and compiled at run time (`--from-file
-/// on`; the build needs `--features jit`): the path of the command line and of Python, with
+/// on`): the path of the command line and of Python, with
 /// its Taylor orders compiled from the first series (`LoadOptions::eager_taylor`), as after
 /// the first steps of any run. `model` is a bundled model's name or a model file's path
 /// (`.yaml`); `name` labels the output lines and picks the reference (`--name`, default the
 /// model). The states of the panel of `tools/peer_panel.py` have 4, 6, 10, 12 and 16
 /// components, those of `tools/taylor_ops_bench.py` 2 (ode_solvers' state is a fixed-size
 /// vector, one copy of its code per size).
-#[cfg(feature = "jit")]
 fn from_file(
     model: &str,
     name: &str,
@@ -491,7 +490,7 @@ fn from_file(
     let path = if model.ends_with(".yaml") {
         model.to_string()
     } else {
-        format!("{}/models/{model}.yaml", env!("CARGO_MANIFEST_DIR"))
+        format!("{}/../models/{model}.yaml", env!("CARGO_MANIFEST_DIR"))
     };
     let options = eomgen::LoadOptions {
         eager_taylor: true,
@@ -511,12 +510,6 @@ fn from_file(
             "{path}: {dim} states; this program runs models of 2, 4, 6, 10, 12 or 16"
         )),
     }
-}
-
-/// Without the `jit` feature there is no run-time compiler to load a file with.
-#[cfg(not(feature = "jit"))]
-fn from_file(_: &str, _: &str, _: &str, _: &[(String, String)]) -> Result<(), String> {
-    Err("--from-file on needs the build's `jit` feature (`--features jit`)".into())
 }
 
 fn main() -> ExitCode {

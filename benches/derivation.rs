@@ -37,7 +37,7 @@
 //!   of the chain of 3-D bodies in relative rotations of `eomgen new universal-joint-chain N`
 //!   for N = 2, 4, 6, 8 joints (issue 52).
 //!
-//! Run with `cargo bench -p eomgen-symbolic --bench derivation`; the side-by-side SymPy
+//! Run with `cargo bench --bench derivation`; the side-by-side SymPy
 //! figures come from `tools/sympy_n_link.py`, the compile time of the generated code from
 //! `tools/compile_time.sh`.
 
@@ -56,7 +56,7 @@ use eomgen_symbolic::mechanics::{
 use eomgen_symbolic::model;
 
 /// The bundled double pendulum (two uniform bars, HW19).
-const DOUBLE_PENDULUM: &str = include_str!("../../models/double_pendulum.yaml");
+const DOUBLE_PENDULUM: &str = include_str!("../models/double_pendulum.yaml");
 
 /// Chain sizes of the `derive_n_link_pendulum_{n}` benches.
 const SIZES: [usize; 5] = [2, 5, 10, 20, 40];
