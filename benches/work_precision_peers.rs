@@ -5,7 +5,7 @@
 //! `tools/heyoka_peer.py` and builds the tables and the chart.
 //!
 //! ```sh
-//! cargo build --release -p eomgen-benches --features peers --example work_precision_peers
+//! cargo build --release -p eomgen-benches --features work-precision --example work_precision_peers
 //! P=target/release/examples/work_precision_peers
 //! $P initial --model double_pendulum            # y(0) as JSON (shortest round-trip digits)
 //! $P rhs --model double_pendulum --state 0.1,0.2,0.3,0.4   # F(0, y) as JSON
@@ -13,9 +13,9 @@
 //!     --tols 1e-2,1e-3,1e-4 --reps 5 [--reference reference.json] [--host-features off]
 //! ```
 //!
-//! With `--from-file on`, eomgen's side and ode_solvers'
-//! run the model loaded from its file and compiled at run time by Cranelift, the path of the
-//! command line and of Python, instead of the copy `model!` compiled into this program.
+//! With `--from-file on`, eomgen's side and ode_solvers' run the model loaded from its file and
+//! compiled at run time by Cranelift, the path of the command line and of Python, instead of
+//! the copy `model!` compiled into this program.
 //!
 //! Models: `double_pendulum` (`models/double_pendulum.yaml`, HW19, 4 states) and
 //! `figure_eight` (`models/figure_eight.yaml`, HW7, 12 states), with the files' default
@@ -474,9 +474,8 @@ fn main_inner() -> Result<(), String> {
 }
 
 /// The subcommand on the model loaded from its file and compiled at run time (`--from-file
-/// on`): the path of the command line and of Python, with
-/// its Taylor orders compiled from the first series (`LoadOptions::eager_taylor`), as after
-/// the first steps of any run. `model` is a bundled model's name or a model file's path
+/// on`): the path of the command line and of Python, with its Taylor orders compiled from the
+/// first series (`LoadOptions::eager_taylor`), as after the first steps of any run. `model` is a bundled model's name or a model file's path
 /// (`.yaml`); `name` labels the output lines and picks the reference (`--name`, default the
 /// model). The states of the panel of `tools/peer_panel.py` have 4, 6, 10, 12 and 16
 /// components, those of `tools/taylor_ops_bench.py` 2 (ode_solvers' state is a fixed-size

@@ -18,7 +18,7 @@ expression, and the time per step above the baseline's is the operation's own co
 Times are medians over `--rounds` rounds (the two codes alternated) of the medians of `--reps`
 runs. Usage (from the repository root, with heyoka, sympy and the eomgen package installed):
 
-    cargo build --release -p eomgen-benches --features peers --example work_precision_peers
+    cargo build --release -p eomgen-benches --features work-precision --example work_precision_peers
     python tools/taylor_ops_bench.py [--tols 1e-6,1e-9,1e-12] [--rounds 5] [--reps 21] [--out ops.md]
 """
 import argparse

@@ -5,7 +5,7 @@ Codes compared, on the same model, initial state and reference:
   later are included by name), and ode_solvers 0.6.2's Dop853 (`--peers
   ode_solvers-dop853`, optionally `ode_solvers-dopri5`), both measured by the Rust program of
   benches/work_precision_peers.rs on the model loaded from its file and compiled at run
-  time, the command line's path (build the example with `--features jit`), or with
+  time, the command line's path, or with
   `--compiled` on the copy `model!` compiled into the program (the double pendulum and the
   figure eight only);
 - heyoka's `taylor_adaptive` (tools/heyoka_peer.py, imported: its integrators are built and
@@ -43,7 +43,7 @@ first table gives that ratio per model and target, and a verdict.
 
 Usage (from the repository root; the driver and heyoka_peer need a Python with heyoka, sympy,
 pyyaml, matplotlib and the eomgen package):
-    cargo build --release -p eomgen-benches --features peers --example work_precision_peers
+    cargo build --release -p eomgen-benches --features work-precision --example work_precision_peers
     python tools/work_precision_peers.py --binary target/release/examples/work_precision_peers \
         [--models double_pendulum,kepler_e09] [--compiled] [--methods dp54,dop853,vern9,taylor] \
         [--peers ode_solvers-dop853] [--rounds 5] [--reps 3] [--per-decade 2] \
@@ -418,7 +418,7 @@ def parse_args():
                         help="eomgen's models as compiled into the Rust program by model! "
                              "(double_pendulum and figure_eight only) instead of loaded from "
                              "their files and compiled at run time, the command line's path "
-                             "(the default; build the example with --features jit)")
+                             "(the default)")
     parser.add_argument("--warm-cache", action="store_true",
                         help="let heyoka use its on-disk cache of compiled integrators")
     return parser.parse_args()
