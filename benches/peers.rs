@@ -66,7 +66,11 @@ use eomgen::{
     BogackiShampine32, DormandPrince54, DormandPrince853, FirstOrder, Integrator,
     IntegratorOptions, ModelInfo, OdeSystem, OutputTimes, RhsError, RungeKutta4,
 };
-use ode_solvers::{Dop853, Dopri5, OutputType};
+use ode_solvers::{Dop853, Dopri5};
+
+#[macro_use]
+#[path = "peer_stepper.rs"]
+mod peer_stepper;
 
 /// The state `[θ₁, θ₂, θ̇₁, θ̇₂]` as ode_solvers holds it (its own nalgebra 0.34 vector).
 type PeerState = ode_solvers::SVector<f64, 4>;
@@ -146,35 +150,23 @@ impl ode_solvers::System<f64, PeerState> for Peer<'_> {
     }
 }
 
-/// `y(T_END)` by ode_solvers' `$solver` (`Dopri5` or `Dop853`, whose `from_param` take the
-/// same arguments) at `rtol = atol = $tol` from `$y0`, with the controller's `beta` and step
-/// ratio bounds `[fac_min, fac_max]`, safety 0.9, `h_max = T_END`, automatic first step, at
-/// most 10⁶ steps, stiffness test every 1000 steps (the defaults), every step recorded
-/// (`OutputType::Sparse`).
+/// `y(T_END)` by ode_solvers' `$solver` at `rtol = atol = $tol` from `$y0`, at most 10⁶
+/// steps (the stepper's settings: `peer_stepper!`).
 ///
 /// # Panics
 /// If the integration fails or does not end at `T_END`.
 macro_rules! peer_final_state {
     ($solver:ident, $rhs:expr, $y0:expr, $tol:expr, $beta:expr, $fac_min:expr, $fac_max:expr) => {{
-        // (f, x, x_end, dx (unused by Sparse), y, rtol, atol, safety, beta, fac_min,
-        //  fac_max, h_max, h (0: automatic), n_max, n_stiff, out_type)
-        let mut stepper = $solver::from_param(
+        let mut stepper = peer_stepper!(
+            $solver,
             Peer($rhs),
-            0.0,
-            T_END,
-            T_END,
             PeerState::from_column_slice($y0),
+            T_END,
             $tol,
-            $tol,
-            0.9,
             $beta,
             $fac_min,
             $fac_max,
-            T_END,
-            0.0,
-            1_000_000,
-            1000,
-            OutputType::Sparse,
+            1_000_000
         );
         stepper.integrate().expect("ode_solvers integrates");
         assert_eq!(stepper.x_out().last(), Some(&T_END));

@@ -64,7 +64,11 @@ mod models {
 }
 use eomgen::{FirstOrder, IntegratorOptions, Method, ModelInfo, OdeSystem, OutputTimes};
 use models::{DoublePendulum, FigureEight};
-use ode_solvers::{Dop853, Dopri5, OutputType};
+use ode_solvers::{Dop853, Dopri5};
+
+#[macro_use]
+#[path = "peer_stepper.rs"]
+mod peer_stepper;
 use serde_json::{Value, json};
 
 /// Largest number of steps of any run.
@@ -157,25 +161,16 @@ macro_rules! peer_run {
                     .expect("the model's right-hand side");
             }
         }
-        // (f, x, x_end, dx (unused by Sparse), y, rtol, atol, safety, beta, fac_min,
-        //  fac_max, h_max, h (0: automatic), n_max, n_stiff, out_type)
-        let mut stepper = $solver::from_param(
+        let mut stepper = peer_stepper!(
+            $solver,
             Peer($system),
-            0.0,
-            $t_end,
-            $t_end,
             ode_solvers::SVector::<f64, $dim>::from_column_slice($y0),
+            $t_end,
             $tol,
-            $tol,
-            0.9,
             $beta,
             $fac_min,
             $fac_max,
-            $t_end,
-            0.0,
-            MAX_STEPS as u32,
-            1000,
-            OutputType::Sparse,
+            MAX_STEPS as u32
         );
         match stepper.integrate() {
             Ok(stats) => match (stepper.x_out().last(), stepper.y_out().last()) {
