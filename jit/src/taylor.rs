@@ -243,7 +243,7 @@ pub(crate) fn compile_orders(
     let pointer = module.target_config().pointer_type();
     let mut context = module.make_context();
     let mut builder_context = FunctionBuilderContext::new();
-    let layout = Layout::new(program);
+    let layout = Layout::new(program, &plan.order_zero);
     let ids = define_orders(
         &mut module,
         (&mut context, &mut builder_context),
@@ -674,10 +674,23 @@ struct Layout {
     pairing: Pairing,
     /// The index among the pair ops of each sine–cosine or sinh–cosh op, by its `sin` slot.
     pair_ops: HashMap<Slot, usize>,
+    /// The value of each slot that order 0 sets to a constant of the tape (not a parameter
+    /// nor an input): the exponents of most powers, whose weights are then constants of the
+    /// code (`Emitter::power_term`).
+    constants: HashMap<Slot, f64>,
 }
 
 impl Layout {
-    fn new(program: &TaylorProgram) -> Self {
+    fn new(program: &TaylorProgram, order_zero: &Tape) -> Self {
+        let constants = order_zero
+            .instructions
+            .iter()
+            .enumerate()
+            .filter_map(|(slot, instruction)| match *instruction {
+                Instruction::Const(x) => Some((slot as Slot, x)),
+                _ => None,
+            })
+            .collect();
         let pair_ops = program
             .ops
             .iter()
@@ -694,7 +707,11 @@ impl Layout {
         } else {
             Pairing::new(program, base)
         };
-        Layout { pairing, pair_ops }
+        Layout {
+            pairing,
+            pair_ops,
+            constants,
+        }
     }
 
     /// The units of scratch the orders use.

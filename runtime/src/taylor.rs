@@ -628,12 +628,17 @@ pub struct TaylorWorkspace {
     reciprocals: Vec<f64>,
     /// A run-time backend's scratch ([`MotionSolve::lanes`]), kept between steps.
     lanes: Vec<Lanes>,
-    /// The entries of a constant `M` (no entry reads the state or the time) whose factors
-    /// `lower`, `pivots`, `inverse_pivots` and `nonzeros` hold, column-major; empty when they
-    /// hold another's. A step whose `M` has these bits reuses the factors instead of
+    /// The slots of a constant `M` (no entry reads the state or the time) whose factors
+    /// `lower`, `pivots`, `inverse_pivots` and `nonzeros` hold, entry by entry as the
+    /// program's `mass_matrix` lists them; empty when they hold another's. A step whose `M`
+    /// has these slots, with the values in `factored_values`, reuses the factors instead of
     /// factoring again (11 % of a figure-eight step at order 5 went into factoring its
     /// constant diagonal `M`).
-    factored_mass: Vec<f64>,
+    factored_mass: Vec<Slot>,
+    /// The distinct slots of `factored_mass` with their values' bits when factored: the
+    /// figure eight's 36 entries are two slots (`m` and 0), so the test of each step reads
+    /// two values rather than 36 (2 % of its step's instructions).
+    factored_values: Vec<(Slot, u64)>,
     /// The coordinates `n` of the program the factors are for: of `[M Jᵀ; J 0]` the first `n`
     /// pivots are positive, the rest negative, so the same bits factor otherwise for another
     /// `n`.
@@ -687,6 +692,7 @@ impl TaylorWorkspace {
         }
         if self.lower.len() != n * n || self.coordinates != program.coordinates.len() {
             self.factored_mass.clear();
+            self.factored_values.clear();
         }
         self.coordinates = program.coordinates.len();
         self.lower.resize(n * n, 0.0);
@@ -806,6 +812,7 @@ fn series_in(
         reciprocals,
         lanes,
         factored_mass,
+        factored_values,
         ..
     } = workspace;
     debug_assert!(
@@ -840,17 +847,29 @@ fn series_in(
     };
     if program.derived.varying_mass_entries.is_empty() {
         // A constant M: factored again only when its entries changed (new parameters).
-        let entries = unknowns * unknowns;
-        let same = factored_mass.len() == entries
-            && (0..entries).all(|e| mass(e).to_bits() == factored_mass[e].to_bits());
+        let slots = &program.mass_matrix[..unknowns * unknowns];
+        let same = factored_mass[..] == *slots
+            && factored_values
+                .iter()
+                .all(|&(slot, bits)| s[slot as usize * c].to_bits() == bits);
         if !same {
             factored_mass.clear();
+            factored_values.clear();
             factor_mass(mass, factors)?;
-            factored_mass.extend((0..entries).map(mass));
+            factored_mass.extend_from_slice(slots);
+            let mut distinct = slots.to_vec();
+            distinct.sort_unstable();
+            distinct.dedup();
+            factored_values.extend(
+                distinct
+                    .into_iter()
+                    .map(|slot| (slot, s[slot as usize * c].to_bits())),
+            );
         }
     } else {
         // The factors become another M's.
         factored_mass.clear();
+        factored_values.clear();
         factor_mass(mass, factors)?;
     }
     let layout = MotionLayout {
@@ -1360,6 +1379,16 @@ fn solve(nonzeros: &[(u32, u32, f64)], inverse_pivots: &[f64], b: &mut [f64]) {
     }
 }
 
+/// `x.fract() == 0.0` (false for infinities and NaN), without the call `trunc` is in the
+/// runtime's baseline build (8 % of the branch check's instructions on the figure eight):
+/// every finite `f64` of magnitude `2⁵²` or more is an integer, and below that the conversion
+/// to `i64` is exact for the integers and truncates the rest.
+fn is_integer(x: f64) -> bool {
+    const EXACT: f64 = 4_503_599_627_370_496.0; // 2⁵²
+    let a = x.abs();
+    (EXACT..f64::INFINITY).contains(&a) || (x as i64) as f64 == x
+}
+
 /// The largest step `τ ≤ h` over which the series of the last [`series_of_motion`] into
 /// `workspace` (of `program`, to `order`) stay on the principal branch of every square root
 /// (`Sqrt`, and the `√(1 − a²)` of `Asin`) and of every power with a non-integer exponent.
@@ -1419,7 +1448,7 @@ pub fn branch_step(
             SeriesOp::Asin { a, root, .. } => (root, Argument::OneMinusSquare(a), 0.5),
             SeriesOp::PowConstant { out, a, exponent } => {
                 let alpha = workspace.series[exponent as usize * c];
-                if alpha.fract() == 0.0 {
+                if is_integer(alpha) {
                     continue;
                 }
                 (out, Argument::Slot(a), alpha)
@@ -1494,7 +1523,43 @@ pub fn branch_step(
 
 #[cfg(test)]
 mod tests {
-    use super::factor;
+    use super::{factor, is_integer};
+
+    /// `is_integer` is `fract() == 0` on the integers, the halves around them, the limits of
+    /// the exact conversion and the values that are not finite.
+    #[test]
+    fn is_integer_is_fract_equal_to_zero() {
+        let exact = 4_503_599_627_370_496.0_f64;
+        let mut cases = vec![
+            0.0,
+            -0.0,
+            1.5,
+            -1.5,
+            0.5,
+            1e-300,
+            exact,
+            exact - 0.5,
+            exact + 1.0,
+            9.3e18,
+            1e300,
+            f64::MAX,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::NAN,
+            f64::MIN_POSITIVE,
+        ];
+        cases.extend((-40..=40).map(|i| i as f64 * 0.25));
+        for x in cases {
+            for x in [
+                x,
+                -x,
+                f64::from_bits(x.to_bits() + 1),
+                f64::from_bits(x.to_bits().wrapping_sub(1)),
+            ] {
+                assert_eq!(is_integer(x), x.fract() == 0.0, "{x:e}");
+            }
+        }
+    }
 
     /// `L D Lᵀ` reproduces the matrix (to rounding: a few ulps of its largest entry), for two
     /// coordinates (the closed form) and three (the loops), and a matrix that is not positive

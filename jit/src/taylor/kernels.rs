@@ -487,7 +487,7 @@ impl Emitter<'_> {
                 };
                 for j in (0..=from).rev() {
                     let (xv, ov) = (self.at(b, a, k - j), self.at(b, out, j));
-                    let term = self.power_term(b, (alpha, k, j), xv, ov);
+                    let term = self.power_term(b, (alpha, exponent, k, j), xv, ov);
                     sum = b.ins().fadd(sum, term);
                 }
                 let x0 = self.at(b, a, 0);
@@ -639,10 +639,17 @@ impl Emitter<'_> {
     pub(super) fn power_term(
         &self,
         b: &mut FunctionBuilder,
-        (alpha, k, j): (ir::Value, usize, usize),
+        (alpha, exponent, k, j): (ir::Value, Slot, usize, usize),
         xv: ir::Value,
         ov: ir::Value,
     ) -> ir::Value {
+        if let Some(&alpha) = self.layout.constants.get(&exponent) {
+            // The same operations in Rust, so the same bits.
+            let weight = alpha * k as f64 - (alpha + 1.0) * j as f64;
+            let weight = self.constant(b, weight);
+            let t = b.ins().fmul(weight, xv);
+            return b.ins().fmul(t, ov);
+        }
         let kc = self.constant(b, k as f64);
         let one = self.constant(b, 1.0);
         let ka = b.ins().fmul(alpha, kc);

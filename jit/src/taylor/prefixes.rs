@@ -156,7 +156,7 @@ impl Emitter<'_> {
                 let j = k - 1 - t;
                 let alpha = older(b, exponent, 0);
                 let (xv, ov) = (older(b, a, k - j), older(b, out, j));
-                self.power_term(b, (alpha, k, j), xv, ov)
+                self.power_term(b, (alpha, exponent, k, j), xv, ov)
             }
             Sum::Mass(e) => {
                 let (_, l, slot) = program.derived.varying_mass_entries[e];
