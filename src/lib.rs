@@ -93,7 +93,7 @@ pub mod models;
 pub mod __private {
     pub use nalgebra;
 
-    pub use eomgen_runtime::functions::{sign, step};
+    pub use eomgen_runtime::functions::{powf, sign, step};
 
     // The Taylor recurrences the generated `TaylorFunctions::order` calls (`eomgen_runtime::taylor::{mul, …}`).
     pub use eomgen_runtime::taylor;

@@ -8,10 +8,13 @@
 //! (`benches/runtime_model.rs`).
 //!
 //! Each is exactly the call the code of `eomgen::model!` makes (`eomgen::__private::{sin, cos,
-//! sin_cos, sign, step}` and the `f64` methods), so a run-time model computes the same bits as
+//! sin_cos, sign, step, powf}` and the `f64` methods), so a run-time model computes the same bits as
 //! the compiled one: sine and cosine from the `libm` crate, the other transcendentals from
 //! the platform's libm behind `f64::exp` and friends.
 
+use cranelift_codegen::ir::{self, InstBuilder};
+use cranelift_frontend::FunctionBuilder;
+use eomgen_symbolic::codegen::tape::{Instruction, Tape};
 use eomgen_symbolic::expr::Func;
 
 /// `sin x` and `cos x` of one `libm::sincos` call, returned in two floating-point registers
@@ -72,8 +75,10 @@ extern "C-unwind" fn step(x: f64) -> f64 {
 extern "C-unwind" fn abs(x: f64) -> f64 {
     x.abs()
 }
+/// `eomgen::__private::powf`, which is this very function (the code compiled at run time
+/// computes a constant half-integer exponent's in line, with the same operations).
 pub(crate) extern "C-unwind" fn powf(x: f64, y: f64) -> f64 {
-    x.powf(y)
+    eomgen_runtime::functions::powf(x, y)
 }
 pub(crate) extern "C-unwind" fn atan2(y: f64, x: f64) -> f64 {
     y.atan2(x)
@@ -108,5 +113,50 @@ pub(crate) fn unary(function: Func) -> extern "C-unwind" fn(f64) -> f64 {
         Func::Sign => sign,
         Func::Step => step,
         Func::Abs => abs,
+    }
+}
+
+/// `(m, negative)` when the exponent `y` of a tape's `Powf` is a constant that
+/// `eomgen_runtime::functions::powf` takes through a square root (`±(m + ½)`), for
+/// [`half_power`] to compute in line.
+pub(crate) fn constant_half_power(tape: &Tape, y: u32) -> Option<(u32, bool)> {
+    match tape.instructions.get(y as usize) {
+        Some(&Instruction::Const(c)) => eomgen_runtime::functions::half_power(c),
+        _ => None,
+    }
+}
+
+/// `eomgen_runtime::functions::powf(x, ±(m + ½))` in line, with its operations in its order
+/// (so its bits): `p = |xᵐ √x|`, `xᵐ` by repeated squaring from the lowest bit, and `p` or
+/// `1/p`. No call, so no registers saved around one.
+pub(crate) fn half_power(
+    b: &mut FunctionBuilder,
+    x: ir::Value,
+    (m, negative): (u32, bool),
+) -> ir::Value {
+    let (mut bits, mut square, mut result) = (m, x, None);
+    while bits != 0 {
+        if bits & 1 == 1 {
+            result = Some(match result {
+                None => square,
+                Some(r) => b.ins().fmul(r, square),
+            });
+        }
+        bits >>= 1;
+        if bits != 0 {
+            square = b.ins().fmul(square, square);
+        }
+    }
+    let root = b.ins().sqrt(x);
+    let power = match result {
+        Some(r) => b.ins().fmul(r, root),
+        None => root,
+    };
+    let p = b.ins().fabs(power);
+    if negative {
+        let one = b.ins().f64const(1.0);
+        b.ins().fdiv(one, p)
+    } else {
+        p
     }
 }

@@ -671,6 +671,11 @@ impl Emitter<'_, '_> {
                 let call = self.call(callee, &[x]);
                 self.b.inst_results(call)[0]
             }
+            Instruction::Powf(x, y) if crate::math::constant_half_power(self.tape, y).is_some() => {
+                let half = crate::math::constant_half_power(self.tape, y);
+                let x = self.value(x);
+                crate::math::half_power(&mut self.b, x, half.unwrap_or((1, false)))
+            }
             Instruction::Powf(x, y) => {
                 let (x, y) = (self.value(x), self.value(y));
                 let callee = imported(

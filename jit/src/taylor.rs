@@ -600,6 +600,11 @@ fn build_order_zero(
                 let call = b.ins().call(callee, &[x]);
                 b.inst_results(call)[0]
             }
+            Instruction::Powf(x, y) if crate::math::constant_half_power(tape, y).is_some() => {
+                let half = crate::math::constant_half_power(tape, y);
+                let x = value(&mut b, x);
+                crate::math::half_power(&mut b, x, half.unwrap_or((1, false)))
+            }
             Instruction::Powf(x, y) => {
                 let (x, y) = (value(&mut b, x), value(&mut b, y));
                 let callee =

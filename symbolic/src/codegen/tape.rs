@@ -63,7 +63,8 @@ pub enum Instruction {
     /// as the generated Rust calls it: `sin` and `cos` from the `libm` crate, `sign` and `step`
     /// as `eomgen::__private` defines them, the others as the `f64` methods of their names.
     Call(Func, Value),
-    /// `xʸ` (`f64::powf`).
+    /// `xʸ` (`eomgen_runtime::functions::powf`: `f64::powf`, but for a half-integer `y`
+    /// from ±3/2 to ±17/2, taken through `√x`).
     Powf(Value, Value),
     /// `atan2(y, x)` (`f64::atan2`), arguments in that order.
     Atan2(Value, Value),

@@ -331,7 +331,7 @@ fn order_zero(
             }
             Instruction::Powf(x, y) => {
                 let (x, y) = (v(&x)?, v(&y)?);
-                quote!(#x.powf(#y))
+                quote!(#private::powf(#x, #y))
             }
             Instruction::Atan2(y, x) => {
                 let (y, x) = (v(&y)?, v(&x)?);

@@ -16,7 +16,7 @@ use super::{Constant, ExprArena, ExprId, Func, Node, SymbolId};
 pub enum Syntax {
     /// Model-file syntax (`m*l^2*theta_dot^2/2`); parses back with the model parser.
     Text,
-    /// Rust `f64` source (`0.5 * m * l.powi(2)`); the helper functions `sign`, `step`, `sin` and `cos`
+    /// Rust `f64` source (`0.5 * m * l.powi(2)`); the helper functions `sign`, `step`, `sin`, `cos` and `powf`
     /// (and `sin_cos` for shared pairs) are called through [`Printer::with_rust_helpers`]'s path.
     Rust,
     /// LaTeX math (`\frac{m l^{2} \dot{\theta}^{2}}{2}`).
@@ -117,7 +117,8 @@ impl<'a> Printer<'a> {
         self
     }
 
-    /// Path of the module that provides `sign(f64)` and `step(f64)` in Rust output.
+    /// Path of the module that provides `sign(f64)`, `step(f64)` and `powf(f64, f64)` in Rust
+    /// output.
     pub fn with_rust_helpers(mut self, path: &str) -> Self {
         self.helpers = path.to_string();
         self
@@ -484,6 +485,7 @@ impl<'a> Printer<'a> {
         let minus_half = Constant::Rational { num: -1, den: 2 };
         match self.syntax {
             Syntax::Rust => {
+                let argument = b.0.clone();
                 let base = self.wrap(b, Prec::Atom);
                 match constant {
                     Some(c) if c == half => (format!("{base}.sqrt()"), Prec::Atom),
@@ -504,7 +506,12 @@ impl<'a> Printer<'a> {
                             PowerExponent::Constant(c) => self.constant(c),
                             PowerExponent::Expr(x) => self.operand(x),
                         };
-                        (format!("{base}.powf({})", x.0), Prec::Atom)
+                        // The runtime's `powf`, which every backend evaluates alike (a
+                        // half-integer exponent through a square root).
+                        (
+                            format!("{}::powf({argument}, {})", self.helpers, x.0),
+                            Prec::Atom,
+                        )
                     }
                 }
             }
