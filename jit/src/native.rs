@@ -12,7 +12,9 @@
 //!
 //! Its body is the tape, instruction for instruction, in one basic block: inputs are loads
 //! at fixed offsets, arithmetic and `sqrt`/`abs` are the IEEE instructions, `sign` and `step`
-//! are compare-and-select, and the transcendentals are calls of the functions of
+//! are compare-and-select, a power with a constant half-integer exponent is its square root
+//! and products ([`crate::math::half_power`], the operations of the `powf` the code of
+//! `eomgen::model!` calls), and the transcendentals are calls of the functions of
 //! [`crate::math`] (the same library functions the code of `eomgen::model!` calls) through
 //! absolute addresses; `sin_cos` returns its pair in two registers. Outputs are stores at
 //! fixed offsets, except runs of [`ZERO_RUN`] or more consecutive outputs that are the
@@ -671,22 +673,23 @@ impl Emitter<'_, '_> {
                 let call = self.call(callee, &[x]);
                 self.b.inst_results(call)[0]
             }
-            Instruction::Powf(x, y) if crate::math::constant_half_power(self.tape, y).is_some() => {
-                let half = crate::math::constant_half_power(self.tape, y);
-                let x = self.value(x);
-                crate::math::half_power(&mut self.b, x, half.unwrap_or((1, false)))
-            }
-            Instruction::Powf(x, y) => {
-                let (x, y) = (self.value(x), self.value(y));
-                let callee = imported(
-                    self.module,
-                    self.b.func,
-                    &mut self.callees.powf,
-                    self.imports.powf,
-                );
-                let call = self.call(callee, &[x, y]);
-                self.b.inst_results(call)[0]
-            }
+            Instruction::Powf(x, y) => match crate::math::constant_half_power(self.tape, y) {
+                Some(half) => {
+                    let x = self.value(x);
+                    crate::math::half_power(&mut self.b, x, half)
+                }
+                None => {
+                    let (x, y) = (self.value(x), self.value(y));
+                    let callee = imported(
+                        self.module,
+                        self.b.func,
+                        &mut self.callees.powf,
+                        self.imports.powf,
+                    );
+                    let call = self.call(callee, &[x, y]);
+                    self.b.inst_results(call)[0]
+                }
+            },
             Instruction::Atan2(y, x) => {
                 let (y, x) = (self.value(y), self.value(x));
                 let callee = imported(

@@ -517,8 +517,9 @@ fn emit_order(
 /// its slot at the stride [`UNROLLED_CAPACITY`] and kept as a Cranelift value for its uses
 /// (the inputs loaded from their slots at each use); a parameter index beyond `parameters`
 /// reads NaN, as the interpreter's.
-// Long: one arm per tape instruction of order 0, each calling the interpreter's helper for the same
-// bits; the match is the instruction set.
+// Long: one arm per tape instruction of order 0, each calling the interpreter's helper (or, for a
+// constant half-integer power, computing its operations in line) for the same bits; the match is
+// the instruction set.
 fn build_order_zero(
     module: &mut JITModule,
     func: &mut ir::Function,
@@ -600,10 +601,11 @@ fn build_order_zero(
                 let call = b.ins().call(callee, &[x]);
                 b.inst_results(call)[0]
             }
-            Instruction::Powf(x, y) if crate::math::constant_half_power(tape, y).is_some() => {
-                let half = crate::math::constant_half_power(tape, y);
+            Instruction::Powf(x, y)
+                if let Some(half) = crate::math::constant_half_power(tape, y) =>
+            {
                 let x = value(&mut b, x);
-                crate::math::half_power(&mut b, x, half.unwrap_or((1, false)))
+                crate::math::half_power(&mut b, x, half)
             }
             Instruction::Powf(x, y) => {
                 let (x, y) = (value(&mut b, x), value(&mut b, y));

@@ -1,6 +1,7 @@
-//! The non-smooth functions of model files, shared by the code `eomgen::model!` generates
-//! (through `eomgen::__private`) and the code compiled at run time, so that both evaluate the
-//! very same function.
+//! The functions of model files whose every evaluation must agree to the bit: the non-smooth
+//! `sign` and `step`, and the power `powf`. The code `eomgen::model!` generates calls them
+//! (through `eomgen::__private`), and the code compiled at run time calls them or computes
+//! their operations in line, so that both evaluate the very same function.
 
 /// Sign of `x`: −1, 0 or 1 (unlike `f64::signum`, 0 at 0; 0 for NaN).
 #[inline]
@@ -66,7 +67,8 @@ pub fn powi_by_squaring(x: f64, m: u32) -> f64 {
 ///
 /// The square root and a few products cost a tenth of `pow` (a call, and in code compiled
 /// at run time the registers saved around it): on the figure eight, whose three `r⁻³` are
-/// such powers, a Taylor step took 5.7 % fewer instructions (docs/performance.md). The code
+/// such powers, a Taylor step took 4.9 % fewer instructions (docs/performance.md, "Fewer
+/// instructions per step"). The code
 /// `model!` generates calls this function, and the code compiled at run time computes the
 /// same operations in line, so both give the same bits.
 ///
@@ -75,8 +77,9 @@ pub fn powi_by_squaring(x: f64, m: u32) -> f64 {
 /// reciprocal once more), against `pow`'s one: for `m = 1`, `x √x` within 1 ulp and
 /// `1/(x √x)` within 1.5. The same values as `pow` at `±0` (through the absolute value),
 /// `+∞` and NaN; NaN for a negative `x`, as `pow`, and for `x = −∞` (where `pow` gives `+∞`
-/// or `+0`). A result near the limits of `f64` can differ where `xᵐ` is subnormal or
-/// overflows while `xʸ` does not quite (`x⁻ʸ` within a few ulps of the largest `f64`).
+/// or `+0`). For a negative `y` near the limits of `f64`, where `p = x^{m+½}` itself is out
+/// of the normal range: `+0` where `p` overflows and `pow` gives a subnormal, and a few ulp
+/// more where `p` is subnormal (results above a quarter of the largest `f64`).
 ///
 /// Source: the square-root expansion of `pow(x, n + 0.5)` in LLVM's library-call
 /// simplifier (`x · x ⋯ √x`), which applies it under relaxed floating-point rules only.

@@ -92,7 +92,8 @@ pub fn generate(
 #[derive(Debug, Clone)]
 pub struct EmitOptions {
     /// Path of the facade crate that re-exports `MechanicalSystem` and has a hidden
-    /// `__private` module with `nalgebra`, `sign` and `step` (default `::eomgen`).
+    /// `__private` module with `nalgebra`, `sign`, `step`, `sin`, `cos`, `powf` and `taylor`
+    /// (default `::eomgen`).
     pub crate_path: String,
     /// Absolute paths of files to track with `include_bytes!` so that editing them rebuilds.
     pub tracked_files: Vec<String>,

@@ -113,7 +113,10 @@ impl Evaluator {
 }
 
 /// `b^e` with integer exponents through `powi` (exact sign for negative bases), `1/2` through
-/// `sqrt`, as the generated code does.
+/// `sqrt`, as the generated code does; any other exponent through `f64::powf`, where the
+/// generated code takes the half-integers `±3/2 … ±17/2` through a square root
+/// (`eomgen_runtime::functions::powf`, within a few ulp of `pow`): this evaluation serves the
+/// derivation's numeric checks, which compare within tolerances.
 pub fn pow(b: f64, e: f64) -> f64 {
     if e.fract() == 0.0 && e.abs() <= i32::MAX as f64 {
         b.powi(e as i32)

@@ -7,8 +7,10 @@
 //! straight-line function per tape, every operation of the tape a local value, so the
 //! exported functions compute what eomgen computes, operation by operation. Only the
 //! library functions differ (the C library's `sin`, NumPy's `np.sin`, …, against the `libm`
-//! crate's), which moves a value by an ulp or so: the tests hold the exported C and Python
-//! to eomgen's values within `1e-13` relative at random states.
+//! crate's; `pow` for a half-integer exponent, which eomgen takes through a square root,
+//! `eomgen_runtime::functions::powf`), which moves a value by an ulp or a few: the tests
+//! hold the exported C and Python to eomgen's values within `1e-13` relative at random
+//! states.
 //!
 //! # What is exported
 //! With `n` coordinates, `m` constraints of which `m_h` holonomic, the state `y = [q; q̇]`
