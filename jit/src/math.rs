@@ -134,19 +134,7 @@ pub(crate) fn half_power(
     x: ir::Value,
     (m, negative): (u32, bool),
 ) -> ir::Value {
-    let (mut bits, mut square, mut result) = (m, x, None);
-    while bits != 0 {
-        if bits & 1 == 1 {
-            result = Some(match result {
-                None => square,
-                Some(r) => b.ins().fmul(r, square),
-            });
-        }
-        bits >>= 1;
-        if bits != 0 {
-            square = b.ins().fmul(square, square);
-        }
-    }
+    let result = eomgen_runtime::functions::squaring(x, m, |r, s| b.ins().fmul(r, s));
     let root = b.ins().sqrt(x);
     let power = match result {
         Some(r) => b.ins().fmul(r, root),

@@ -44,20 +44,27 @@ pub fn half_power(y: f64) -> Option<(u32, bool)> {
 /// in the same order.
 #[inline]
 pub fn powi_by_squaring(x: f64, m: u32) -> f64 {
-    let (mut bits, mut square, mut result) = (m, x, None::<f64>);
+    squaring(x, m, |a, b| a * b).unwrap_or(1.0)
+}
+
+/// [`powi_by_squaring`]'s products, each made by `mul` (`None` for `m = 0`): what the code
+/// compiled at run time emits the same products with, in the same order.
+#[inline]
+pub fn squaring<T: Copy>(x: T, m: u32, mut mul: impl FnMut(T, T) -> T) -> Option<T> {
+    let (mut bits, mut square, mut result) = (m, x, None);
     while bits != 0 {
         if bits & 1 == 1 {
             result = Some(match result {
                 None => square,
-                Some(r) => r * square,
+                Some(r) => mul(r, square),
             });
         }
         bits >>= 1;
         if bits != 0 {
-            square = square * square;
+            square = mul(square, square);
         }
     }
-    result.unwrap_or(1.0)
+    result
 }
 
 /// `xʸ` as every backend evaluates a model's power with an exponent other than ½, −½ or an

@@ -637,7 +637,7 @@ pub struct TaylorWorkspace {
     factored_mass: Vec<Slot>,
     /// The distinct slots of `factored_mass` with their values' bits when factored: the
     /// figure eight's 36 entries are two slots (`m` and 0), so the test of each step reads
-    /// two values rather than 36 (2 % of its step's instructions).
+    /// two values rather than 36 (4 % of its step's instructions: 363 of 8,851 at 10⁻⁹).
     factored_values: Vec<(Slot, u64)>,
     /// The coordinates `n` of the program the factors are for: of `[M Jᵀ; J 0]` the first `n`
     /// pivots are positive, the rest negative, so the same bits factor otherwise for another
