@@ -803,8 +803,11 @@ fn impact_holding(
         }
         let r = match impact(mass.as_slice(), &y[n..2 * n], &law, &rows) {
             Ok(r) => r,
-            Err(ImpactError::Singular) if hold.contains(&true) => {
-                last_error = Some(ImpactError::Singular);
+            // Singular, or so near it that rounding decides the result: as singular.
+            Err(error @ (ImpactError::Singular | ImpactError::IllConditioned { .. }))
+                if hold.contains(&true) =>
+            {
+                last_error = Some(error);
                 hold.fill(false);
                 demoted = true;
                 continue;
