@@ -37,7 +37,7 @@ FEW, MANY = 5, 25
 def count(binary, args, tol, reps):
     """(instructions, steps, first component of the final state) of one run under callgrind."""
     cmd = ["valgrind", "--tool=callgrind", "--smc-check=all", "--callgrind-out-file=/dev/null",
-           binary, "run", "--from-file", "on", "--model", args.model, "--t-end", args.t_end,
+           binary, "run", "--from-file", args.from_file, "--model", args.model, "--t-end", args.t_end,
            "--methods", args.methods, "--tols", tol, "--reps", str(reps)]
     if args.set:
         cmd += ["--set", args.set]
@@ -62,6 +62,9 @@ def main():
     parser.add_argument("--tols", default="1e-9")
     parser.add_argument("--methods", default="taylor", help="one method")
     parser.add_argument("--set", help="changes to the initial state, name=value,...")
+    parser.add_argument("--from-file", default="on", choices=["on", "off"],
+                        help="off: the copy `model!` compiled into the program (a model it "
+                             "bundles, by name)")
     args = parser.parse_args()
     binaries = args.binary or [str(Path(target) / "release/examples/work_precision_peers")]
     for tol in args.tols.split(","):
