@@ -1429,14 +1429,7 @@ pub fn branch_step(
     let c = workspace.capacity;
     // Orders 0 … order − 1 of the program's slots are computed.
     let degree = order - 1;
-    let series = |slot: Slot| &workspace.series[slot as usize * c..][..=degree];
-    let value = |slot: Slot, tau: f64| series(slot).iter().rev().fold(0.0, |v, &x| v * tau + x);
-    /// The argument of a root or power: a slot, or `1 − a²` of `Asin`'s slot `a`.
-    #[derive(Clone, Copy)]
-    enum Argument {
-        Slot(Slot),
-        OneMinusSquare(Slot),
-    }
+    let s = &workspace.series;
     let mut limit = h;
     for &index in program.derived.branch_points.iter() {
         // An index past the ops (a `derived` not made from this program) names no op.
@@ -1447,7 +1440,7 @@ pub fn branch_step(
             SeriesOp::Sqrt { out, a } => (out, Argument::Slot(a), 0.5),
             SeriesOp::Asin { a, root, .. } => (root, Argument::OneMinusSquare(a), 0.5),
             SeriesOp::PowConstant { out, a, exponent } => {
-                let alpha = workspace.series[exponent as usize * c];
+                let alpha = s[exponent as usize * c];
                 if is_integer(alpha) {
                     continue;
                 }
@@ -1461,64 +1454,96 @@ pub fn branch_step(
         // for the finite series a step has here (`series_of_motion` refuses any other), after
         // a chain of `order` dependent multiply–adds (two of three such chains per power
         // per step, on the figure eight's r⁻³).
-        let start = series(out)[0];
-        if !(start > 0.0 && start.is_finite()) {
+        let f = &s[out as usize * c..][..=degree];
+        let start = f[0];
+        if !(start > 0.0 && start < f64::INFINITY) {
             continue;
         }
         // Where the argument's series cannot fall below half its start in the step
         // (Σₖ₌₁ |gᵏ| τᵏ < g⁰/2), the branch point g = 0 is away from the step and f = g^α is
         // its series (the usual case, decided by one sum); for `Asin`'s root, whose argument
         // 1 − a² has no series of its own, where f cannot change sign (Σₖ₌₁ |fᵏ| τᵏ < f⁰).
-        let moved = |slot: Slot| {
-            series(slot)[1..]
+        let moved = |series: &[f64]| {
+            series[1..]
                 .iter()
                 .rev()
                 .fold(0.0, |v, &x| v * limit + x.abs())
                 * limit
         };
         let far = match argument {
-            Argument::Slot(a) => moved(a) < 0.5 * series(a)[0],
-            Argument::OneMinusSquare(_) => moved(out) < start,
-        };
-        if far {
-            continue;
-        }
-        let argument_at = |tau: f64| match argument {
-            Argument::Slot(a) => value(a, tau),
-            Argument::OneMinusSquare(a) => {
-                let x = value(a, tau);
-                1.0 - x * x
+            Argument::Slot(a) => {
+                let g = &s[a as usize * c..][..=degree];
+                moved(g) < 0.5 * g[0]
             }
+            Argument::OneMinusSquare(_) => moved(f) < start,
         };
-        // Also skips a NaN argument.
-        if argument_at(0.0).partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
-            continue;
+        if !far && let Some(off) = first_off_branch(s, c, degree, (out, argument, alpha), limit) {
+            limit = 0.5 * off;
         }
-        // Written so that a NaN is off the branch.
-        let off = |tau: f64| {
-            let (f, g) = (value(out, tau), argument_at(tau));
-            let on = f > 0.0 && g > 0.0 && (f - g.powf(alpha)).abs() <= 1e-3 * f.max(start);
-            !on
-        };
-        const SAMPLES: usize = 16;
-        let Some(j) = (1..=SAMPLES).find(|&j| off(limit * j as f64 / SAMPLES as f64)) else {
-            continue;
-        };
-        let (mut below, mut above) = (
-            limit * (j - 1) as f64 / SAMPLES as f64,
-            limit * j as f64 / SAMPLES as f64,
-        );
-        for _ in 0..30 {
-            let middle = 0.5 * (below + above);
-            if off(middle) {
-                above = middle;
-            } else {
-                below = middle;
-            }
-        }
-        limit = 0.5 * above;
     }
     limit
+}
+
+/// The argument of a root or power: a slot, or `1 − a²` of `Asin`'s slot `a`.
+#[derive(Clone, Copy)]
+enum Argument {
+    Slot(Slot),
+    OneMinusSquare(Slot),
+}
+
+/// [`branch_step`]'s samples of `f = g^α` (`out`, its `argument` and `α`) over `[0, limit]`
+/// in `series` (stride `c`, orders to `degree`): where `f` or `g` has left its sign, or `f`
+/// is no longer `g^α` to 10⁻³, or either is not finite, that point (bisected to `limit /
+/// 2³⁴`); `None` where every sample is on the branch. Apart from the loop over the points,
+/// which it leaves without a sample in the usual step.
+#[cold]
+#[inline(never)]
+fn first_off_branch(
+    series: &[f64],
+    c: usize,
+    degree: usize,
+    (out, argument, alpha): (Slot, Argument, f64),
+    limit: f64,
+) -> Option<f64> {
+    let value = |slot: Slot, tau: f64| {
+        series[slot as usize * c..][..=degree]
+            .iter()
+            .rev()
+            .fold(0.0, |v, &x| v * tau + x)
+    };
+    let argument_at = |tau: f64| match argument {
+        Argument::Slot(a) => value(a, tau),
+        Argument::OneMinusSquare(a) => {
+            let x = value(a, tau);
+            1.0 - x * x
+        }
+    };
+    // Also skips a NaN argument.
+    if argument_at(0.0).partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+        return None;
+    }
+    let start = series[out as usize * c];
+    // Written so that a NaN is off the branch.
+    let off = |tau: f64| {
+        let (f, g) = (value(out, tau), argument_at(tau));
+        let on = f > 0.0 && g > 0.0 && (f - g.powf(alpha)).abs() <= 1e-3 * f.max(start);
+        !on
+    };
+    const SAMPLES: usize = 16;
+    let j = (1..=SAMPLES).find(|&j| off(limit * j as f64 / SAMPLES as f64))?;
+    let (mut below, mut above) = (
+        limit * (j - 1) as f64 / SAMPLES as f64,
+        limit * j as f64 / SAMPLES as f64,
+    );
+    for _ in 0..30 {
+        let middle = 0.5 * (below + above);
+        if off(middle) {
+            above = middle;
+        } else {
+            below = middle;
+        }
+    }
+    Some(above)
 }
 
 #[cfg(test)]
