@@ -10,7 +10,9 @@ that moves the count is still checked in time (docs/performance.md, "Fewer instr
 step").
 
 For each model and tolerance, `work_precision_peers run --from-file on` (the command line's path:
-the model loaded from its file and compiled at run time, its Taylor orders at the first series)
+the model loaded from its file and compiled at run time, its Taylor orders at the first series;
+with `--from-file off`, the copy `model!` compiled into the program, `--model double_pendulum`
+or `figure_eight` by name)
 runs under `valgrind --tool=callgrind --smc-check=all` twice, with `--reps 5` and `--reps 25`; the
 difference over 20 times the run's steps is the count per step, without the load, the compile and
 the first runs. Usage (from the repository root, valgrind installed):
@@ -57,7 +59,9 @@ def main():
     parser.add_argument("--binary", action="append",
                         help="the work-precision program (default: the release build's); "
                              "repeat to compare")
-    parser.add_argument("--model", required=True, help="a model file's path")
+    parser.add_argument("--model", required=True,
+                        help="a model file's path (with --from-file off, a model the program "
+                             "compiles in, by name)")
     parser.add_argument("--t-end", required=True)
     parser.add_argument("--tols", default="1e-9")
     parser.add_argument("--methods", default="taylor", help="one method")

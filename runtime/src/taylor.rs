@@ -1492,10 +1492,11 @@ enum Argument {
 }
 
 /// [`branch_step`]'s samples of `f = g^α` (`out`, its `argument` and `α`) over `[0, limit]`
-/// in `series` (stride `c`, orders to `degree`): where `f` or `g` has left its sign, or `f`
-/// is no longer `g^α` to 10⁻³, or either is not finite, that point (bisected to `limit /
-/// 2³⁴`); `None` where every sample is on the branch. Apart from the loop over the points,
-/// which it leaves without a sample in the usual step.
+/// in `series` (stride `c`, orders to `degree`): the first point where `f` or `g` has left
+/// its sign, or `f` is no longer `g^α` to 10⁻³, or either is not finite (bisected to `limit /
+/// 2³⁴`); `None` where every sample is on the branch, or where the argument at `τ = 0` is not
+/// positive (NaN included). A function of its own, out of line, so that the loop over the
+/// points, which the usual step leaves without a sample, keeps its registers.
 #[cold]
 #[inline(never)]
 fn first_off_branch(

@@ -246,7 +246,8 @@ pub enum ImpactError {
 /// # Errors
 /// [`ImpactError`]: wrong lengths, NaN or infinite inputs, `e ∉ [0, 1]`, `μ < 0`, a contact
 /// that is not closing, singular equations, and the inconsistencies of kinematic restitution
-/// with friction (no pushing normal impulse, a gain of energy).
+/// with friction (no pushing normal impulse, a gain of energy), and equations too
+/// ill-conditioned for the impulses they need (their error would decide the speeds after).
 pub fn impact(
     mass_matrix: &[f64],
     qdot: &[f64],
@@ -297,25 +298,9 @@ pub fn impact(
         }
     };
     let (p, q) = (process.normal_impulse, process.tangential_impulse);
-    let mut after = qdot.to_vec();
-    let mut held_impulses: Vec<f64> = normal.held.iter().map(|l| l * p).collect();
-    for (v, w) in after.iter_mut().zip(&normal.velocity) {
-        *v += w * p;
-    }
-    if let Some((_, t)) = &tangent {
-        for (v, w) in after.iter_mut().zip(&t.velocity) {
-            *v += w * q;
-        }
-        for (h, l) in held_impulses.iter_mut().zip(&t.held) {
-            *h += l * q;
-        }
-    }
-    check_accuracy(
-        qdot,
-        &after,
-        (p, &normal),
-        tangent.as_ref().map(|(_, t)| (q, t)),
-    )?;
+    let tangent = tangent.as_ref().map(|(_, t)| (q, t));
+    let (after, held_impulses) = apply_impulses(qdot, (p, &normal), tangent);
+    check_accuracy(qdot, &after, (p, &normal), tangent)?;
     let kinetic_energy = [
         kinetic_energy(mass_matrix, qdot),
         kinetic_energy(mass_matrix, &after),
@@ -352,6 +337,29 @@ pub fn impact(
     })
 }
 
+/// The speeds after the impulses `p` along the normal and `q` along the tangent (with their
+/// responses), `q̇⁻ + w_N p + w_T q`, and the impulses of the held rows, `Λ_A`.
+fn apply_impulses(
+    qdot: &[f64],
+    (p, normal): (f64, &Response),
+    tangent: Option<(f64, &Response)>,
+) -> (Vec<f64>, Vec<f64>) {
+    let mut after = qdot.to_vec();
+    let mut held_impulses: Vec<f64> = normal.held.iter().map(|l| l * p).collect();
+    for (v, w) in after.iter_mut().zip(&normal.velocity) {
+        *v += w * p;
+    }
+    if let Some((q, t)) = tangent {
+        for (v, w) in after.iter_mut().zip(&t.velocity) {
+            *v += w * q;
+        }
+        for (h, l) in held_impulses.iter_mut().zip(&t.held) {
+            *h += l * q;
+        }
+    }
+    (after, held_impulses)
+}
+
 /// Whether the speeds after an impact, `after`, are known to [`ACCURACY`] of the speeds: the
 /// error the responses' solves leave in them, `Λ_N |δw_N| + |Λ_T| |δw_T|`, against the largest
 /// speed before or after.
@@ -365,7 +373,7 @@ fn check_accuracy(
     tangent: Option<(f64, &Response)>,
 ) -> Result<(), ImpactError> {
     let uncertainty = (0..qdot.len())
-        .map(|i| p * normal.error[i] + tangent.map_or(0.0, |(q, t)| q.abs() * t.error[i]))
+        .map(|i| p.abs() * normal.error[i] + tangent.map_or(0.0, |(q, t)| q.abs() * t.error[i]))
         .fold(0.0, f64::max);
     let speed = qdot
         .iter()
@@ -664,7 +672,8 @@ fn routh(
     };
     let mut rate = a.nn.plus(slope, a.nt);
     if mode == ImpactMode::Sticking {
-        // The ratio's own error: `nn − nt²/tt` moves by `2 |ratio| δnt + ratio² δtt` more.
+        // The ratio's own error: `nn − nt²/tt` moves by `δnn + 2 |ratio| δnt + ratio² δtt` in
+        // all, of which `plus` counted `δnn + |ratio| δnt`.
         rate.error += ratio.abs() * a.nt.error + ratio * ratio * a.tt.error;
     }
     if mode == ImpactMode::Sticking && rate.is_zero() && normal.abs() <= LOCKED * v_n.abs() {
