@@ -574,6 +574,18 @@ impl Emitter<'_, '_> {
         call
     }
 
+    /// A call of the import `id`, its reference declared on first use and kept in the field
+    /// of [`Callees`] that `cached` picks.
+    fn call_import(
+        &mut self,
+        cached: fn(&mut Callees) -> &mut Option<ir::FuncRef>,
+        id: FuncId,
+        arguments: &[ir::Value],
+    ) -> ir::Inst {
+        let callee = imported(self.module, self.b.func, cached(&mut self.callees), id);
+        self.call(callee, arguments)
+    }
+
     /// The reference to the helper of the function of one argument `f`; every such function
     /// is imported, so it is always found.
     fn unary_callee(&mut self, f: Func) -> Option<ir::FuncRef> {
@@ -680,36 +692,18 @@ impl Emitter<'_, '_> {
                 }
                 None => {
                     let (x, y) = (self.value(x), self.value(y));
-                    let callee = imported(
-                        self.module,
-                        self.b.func,
-                        &mut self.callees.powf,
-                        self.imports.powf,
-                    );
-                    let call = self.call(callee, &[x, y]);
+                    let call = self.call_import(|c| &mut c.powf, self.imports.powf, &[x, y]);
                     self.b.inst_results(call)[0]
                 }
             },
             Instruction::Atan2(y, x) => {
                 let (y, x) = (self.value(y), self.value(x));
-                let callee = imported(
-                    self.module,
-                    self.b.func,
-                    &mut self.callees.atan2,
-                    self.imports.atan2,
-                );
-                let call = self.call(callee, &[y, x]);
+                let call = self.call_import(|c| &mut c.atan2, self.imports.atan2, &[y, x]);
                 self.b.inst_results(call)[0]
             }
             Instruction::SinCos(x) => {
                 let x = self.value(x);
-                let callee = imported(
-                    self.module,
-                    self.b.func,
-                    &mut self.callees.sin_cos,
-                    self.imports.sin_cos,
-                );
-                let call = self.call(callee, &[x]);
+                let call = self.call_import(|c| &mut c.sin_cos, self.imports.sin_cos, &[x]);
                 let results = self.b.inst_results(call);
                 let (s, c) = (results[0], results[1]);
                 self.values.values[k] = Some(s);

@@ -41,7 +41,7 @@ pub fn half_power(y: f64) -> Option<(u32, bool)> {
 
 /// `xᵐ` for `m ≥ 1` by repeated squaring from the lowest bit, the first set bit taken as it is
 /// (`1 · x = x`): the products of the tape's `powi` and of LLVM's expansion of `f64::powi`,
-/// in the same order.
+/// in the same order; 1 for `m = 0`.
 #[inline]
 pub fn powi_by_squaring(x: f64, m: u32) -> f64 {
     squaring(x, m, |a, b| a * b).unwrap_or(1.0)

@@ -470,7 +470,7 @@ struct Response {
 /// Numerical Algorithms*, 2nd ed., 2002, §12.1), which the rounding of the products alone
 /// (`ε Σ |Gᵢ wᵢ|`) understates by the condition number: on a contact with one free direction
 /// left by three held rows (`κ ≈ 3·10⁴`), sticking's normal rate, 0 in exact arithmetic, came
-/// out at 30 rounding units of its products.
+/// out above the rounding of its products and was taken for a positive one.
 fn response(
     mass_matrix: &[f64],
     held: &[&[f64]],
