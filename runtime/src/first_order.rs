@@ -694,12 +694,12 @@ fn taylor_support<S: DynMechanicalSystem + ?Sized>(
     system: &S,
     stabilization: Stabilization,
 ) -> Result<&dyn TaylorFunctions, TaylorUnsupported> {
-    let constrained = !system.description().constraints.is_empty();
-    if constrained
-        && !matches!(
-            stabilization,
-            Stabilization::None | Stabilization::Projection
-        )
+    // The stabilization first: the model's description (a dynamic call) is read only when
+    // the stabilization has terms the recurrences lack (once per series of every step).
+    if !matches!(
+        stabilization,
+        Stabilization::None | Stabilization::Projection
+    ) && !system.description().constraints.is_empty()
     {
         return Err(TaylorUnsupported::Stabilization {
             name: std::borrow::Cow::Borrowed(stabilization.name()),

@@ -261,48 +261,48 @@ impl TaylorStepper {
         }
     }
 
-    /// Computes the coefficients at `(t, y)` into `scratch`; the order used.
+    /// Computes the coefficients at `(t, y)` into `scratch`; the order used and `‖y‖`.
     fn series(
         &mut self,
         rhs: &mut CheckedRhs<'_>,
         t: f64,
         y: &[f64],
-    ) -> Result<usize, StepFailure> {
-        let order = if self.relative(max_norm(y)) {
+    ) -> Result<(usize, f64), StepFailure> {
+        let norm = row_norm(y, 0, self.dim);
+        let order = if self.relative(norm) {
             self.relative_order
         } else {
             self.absolute_order
         };
         let size = (order + 1) * self.dim;
         rhs.taylor_coefficients(t, y, order, &mut self.scratch[..size])?;
-        Ok(order)
+        Ok((order, norm))
     }
 
     with_host_features! {
-        /// Makes the coefficients in `scratch` (of `order`) the current ones and proposes the
-        /// next step from them.
-        fn commit(stepper: &mut TaylorStepper, order: usize) {
-            stepper.commit_in(order);
+        /// Makes the coefficients in `scratch` (of `order`, at a state of max norm `norm`)
+        /// the current ones and proposes the next step from them.
+        fn commit(stepper: &mut TaylorStepper, series: (usize, f64)) {
+            stepper.commit_in(series.0, series.1);
         }
     }
 
     /// [`Self::commit`]'s body, inlined into its two copies.
     #[inline(always)]
-    fn commit_in(&mut self, order: usize) {
+    fn commit_in(&mut self, order: usize, norm: f64) {
         std::mem::swap(&mut self.coefficients, &mut self.scratch);
         self.order = order;
         let dim = self.dim;
         let c = &self.coefficients;
-        let (_, n) = self.mode(max_norm(&c[..dim]));
+        // Row 0 is the state the series was computed at (`norm` is its max norm).
+        let (_, n) = self.mode(norm);
         // N = 1 in the absolute mode.
         let ln_n = if n == 1.0 { 0.0 } else { n.ln() };
         // ln ρ_k: the radius of the last two orders as one exponential of the smaller
         // logarithm (three `ln` and one `exp` in place of two `powf` and an `exp`; in `perf`,
         // 5 % of a double-pendulum step at 1e-9 in `pow` before, 4 % in `log` and `exp`).
         // `ln ρ_k` as `(ln N − ln ‖x^[k]‖) · reciprocal`, `reciprocal = 1/k`.
-        let ln_rho = |k: usize, reciprocal: f64| {
-            (ln_n - max_norm(&c[k * dim..(k + 1) * dim]).ln()) * reciprocal
-        };
+        let ln_rho = |k: usize, reciprocal: f64| (ln_n - row_norm(c, k, dim).ln()) * reciprocal;
         let rho = |k: usize| ln_rho(k, 1.0 / k as f64).exp();
         let p = order;
         if self.factor_order != p {
@@ -327,13 +327,20 @@ impl TaylorStepper {
         let mut radius = ln_rho(p - 1, r1).min(ln_rho(p, r0)).exp();
         // ρ_k < r/2 exactly when ‖x^[k]‖ (r/2)ᵏ > N: the earlier orders cost no logarithm
         // unless they decide, and (r/2)ᵏ is one power and then products.
-        let mut power = (0.5 * radius).powi(first as i32);
-        let anomalous = (first..p - 1).any(|k| {
-            let norm = max_norm(&c[k * dim..(k + 1) * dim]);
-            let large = norm > 0.0 && norm * power > n;
-            power *= 0.5 * radius;
-            large
-        });
+        // (A loop rather than `any`, whose closure and running power were compiled out of
+        // line as `try_fold`: about 110 instructions a step on the Kepler orbit in callgrind,
+        // and the step 70 fewer as a loop.)
+        let half = 0.5 * radius;
+        let mut power = half.powi(first as i32);
+        let mut anomalous = false;
+        for k in first..p - 1 {
+            let norm = row_norm(c, k, dim);
+            if norm > 0.0 && norm * power > n {
+                anomalous = true;
+                break;
+            }
+            power *= half;
+        }
         if anomalous {
             radius = (first..p - 1).map(rho).fold(f64::INFINITY, f64::min);
         }
@@ -464,6 +471,25 @@ fn horner_of_size<const D: usize>(
     }
 }
 
+/// The max norm of row `k` of the order-major rows of `dim` values in `c`, the state's usual
+/// sizes compiled for their size (the row's values in registers, no loop), as [`max_norm`]
+/// (the same maximum: the same comparisons in the same order).
+#[inline(always)]
+fn row_norm(c: &[f64], k: usize, dim: usize) -> f64 {
+    #[inline(always)]
+    fn of_size<const D: usize>(c: &[f64], k: usize) -> f64 {
+        max_norm(&c[k * D..(k + 1) * D])
+    }
+    match dim {
+        2 => of_size::<2>(c, k),
+        4 => of_size::<4>(c, k),
+        6 => of_size::<6>(c, k),
+        8 => of_size::<8>(c, k),
+        12 => of_size::<12>(c, k),
+        _ => max_norm(&c[k * dim..(k + 1) * dim]),
+    }
+}
+
 /// The max norm `maxᵢ |vᵢ|` (NaN entries skipped, as `f64::max` does: a comparison and a
 /// select, one `maxsd` each, where `f64::max`'s rule for NaN took four instructions per entry).
 fn max_norm(v: &[f64]) -> f64 {
@@ -515,9 +541,9 @@ impl Stepper for TaylorStepper {
         self.t_new = t0;
         self.y.copy_from_slice(y0);
         self.carry.fill(0.0);
-        let order = self.series(rhs, t0, y0)?;
-        Self::commit(self, order);
-        self.proposed = rhs.taylor_branch_step(order, self.proposed);
+        let series = self.series(rhs, t0, y0)?;
+        Self::commit(self, series);
+        self.proposed = rhs.taylor_branch_step(series.0, self.proposed);
         Ok(())
     }
 
@@ -551,14 +577,14 @@ impl Stepper for TaylorStepper {
 
     fn accept(&mut self, rhs: &mut CheckedRhs<'_>) -> Result<(), StepFailure> {
         let (t_new, y_new) = (self.t_new, std::mem::take(&mut self.y_new));
-        let order = self.series(rhs, t_new, &y_new);
+        let series = self.series(rhs, t_new, &y_new);
         self.y_new = y_new;
-        let order = order?;
+        let series = series?;
         // The coefficients at the step's start become its dense output.
         std::mem::swap(&mut self.previous, &mut self.coefficients);
         self.previous_order = self.order;
-        Self::commit(self, order);
-        self.proposed = rhs.taylor_branch_step(order, self.proposed);
+        Self::commit(self, series);
+        self.proposed = rhs.taylor_branch_step(series.0, self.proposed);
         self.t_prev = self.t;
         self.t = t_new;
         std::mem::swap(&mut self.y, &mut self.y_new);
