@@ -695,7 +695,8 @@ fn taylor_support<S: DynMechanicalSystem + ?Sized>(
     stabilization: Stabilization,
 ) -> Result<&dyn TaylorFunctions, TaylorUnsupported> {
     // The stabilization first: the model's description (a dynamic call) is read only when
-    // the stabilization has terms the recurrences lack (once per series of every step).
+    // the stabilization has terms the recurrences lack (this runs twice a step: for the
+    // series and for the branch check).
     if !matches!(
         stabilization,
         Stabilization::None | Stabilization::Projection
