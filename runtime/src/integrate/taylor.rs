@@ -11,6 +11,37 @@ use super::solution::Solution;
 use super::stepper::{CheckedRhs, StepFailure, Stepper, SystemShape};
 use crate::ode::OdeSystem;
 
+/// `$sized` with `$d` a constant, for the state's usual sizes (2, 4, 6, 8 and 12 values:
+/// code compiled for the size, a row's values in registers and no loop over them), else
+/// `$other`: the one list of those sizes, for the state's polynomial and the rows' norms.
+macro_rules! by_usual_size {
+    ($dim:expr, $d:ident => $sized:expr, _ => $other:expr $(,)?) => {
+        match $dim {
+            2 => {
+                const $d: usize = 2;
+                $sized
+            }
+            4 => {
+                const $d: usize = 4;
+                $sized
+            }
+            6 => {
+                const $d: usize = 6;
+                $sized
+            }
+            8 => {
+                const $d: usize = 8;
+                $sized
+            }
+            12 => {
+                const $d: usize = 12;
+                $sized
+            }
+            _ => $other,
+        }
+    };
+}
+
 /// The Taylor method of adaptive order and step (Jorba & Zou 2005; Biscani & Izzo 2021):
 /// every step evaluates the Taylor polynomial of the solution at the current state, its
 /// coefficients computed to order `p` by the model's generated recurrences
@@ -390,12 +421,8 @@ impl TaylorStepper {
         out: &mut [f64],
         carry_out: Option<&mut [f64]>,
     ) {
-        match dim {
-            2 => horner_of_size::<2>(coefficients, order, tau, carry, out, carry_out),
-            4 => horner_of_size::<4>(coefficients, order, tau, carry, out, carry_out),
-            6 => horner_of_size::<6>(coefficients, order, tau, carry, out, carry_out),
-            8 => horner_of_size::<8>(coefficients, order, tau, carry, out, carry_out),
-            12 => horner_of_size::<12>(coefficients, order, tau, carry, out, carry_out),
+        by_usual_size! { dim,
+            D => horner_of_size::<D>(coefficients, order, tau, carry, out, carry_out),
             _ => {
                 if order == 0 {
                     out.fill(0.0);
@@ -479,12 +506,8 @@ fn row_norm(c: &[f64], k: usize, dim: usize) -> f64 {
     fn of_size<const D: usize>(c: &[f64], k: usize) -> f64 {
         max_norm(&c[k * D..(k + 1) * D])
     }
-    match dim {
-        2 => of_size::<2>(c, k),
-        4 => of_size::<4>(c, k),
-        6 => of_size::<6>(c, k),
-        8 => of_size::<8>(c, k),
-        12 => of_size::<12>(c, k),
+    by_usual_size! { dim,
+        D => of_size::<D>(c, k),
         _ => max_norm(&c[k * dim..(k + 1) * dim]),
     }
 }
