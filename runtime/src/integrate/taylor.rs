@@ -16,27 +16,14 @@ use crate::ode::OdeSystem;
 /// `$other`: the one list of those sizes, for the state's polynomial and the rows' norms.
 macro_rules! by_usual_size {
     ($dim:expr, $d:ident => $sized:expr, _ => $other:expr $(,)?) => {
+        by_usual_size!(@sizes $dim, $d, $sized, $other; 2 4 6 8 12)
+    };
+    (@sizes $dim:expr, $d:ident, $sized:expr, $other:expr; $($size:literal)*) => {
         match $dim {
-            2 => {
-                const $d: usize = 2;
+            $($size => {
+                const $d: usize = $size;
                 $sized
-            }
-            4 => {
-                const $d: usize = 4;
-                $sized
-            }
-            6 => {
-                const $d: usize = 6;
-                $sized
-            }
-            8 => {
-                const $d: usize = 8;
-                $sized
-            }
-            12 => {
-                const $d: usize = 12;
-                $sized
-            }
+            })*
             _ => $other,
         }
     };
