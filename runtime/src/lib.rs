@@ -41,19 +41,27 @@
 macro_rules! with_host_features {
     ($(#[$meta:meta])* $vis:vis fn $name:ident($($arg:ident: $ty:ty),* $(,)?) $(-> $ret:ty)? $body:block) => {
         $(#[$meta])*
+        // The choice in line in the caller, each copy out of line: one call, not a call of a
+        // function that calls the copy.
+        #[inline(always)]
         $vis fn $name($($arg: $ty),*) $(-> $ret)? {
             #[inline(always)]
             fn body($($arg: $ty),*) $(-> $ret)? $body
             #[cfg(target_arch = "x86_64")]
             if $crate::taylor::host_features() {
                 #[target_feature(enable = "avx2,fma")]
+                #[inline(never)]
                 unsafe fn with_avx2($($arg: $ty),*) $(-> $ret)? {
                     body($($arg),*)
                 }
                 // SAFETY: the processor has AVX2 and FMA (`host_features`).
                 return unsafe { with_avx2($($arg),*) };
             }
-            body($($arg),*)
+            #[inline(never)]
+            fn for_any_processor($($arg: $ty),*) $(-> $ret)? {
+                body($($arg),*)
+            }
+            for_any_processor($($arg),*)
         }
     };
 }
