@@ -484,6 +484,7 @@ impl DynMechanicalSystem for JitModel {
     fn description(&self) -> &ModelDescription {
         &self.code.program.description
     }
+    #[inline]
     fn taylor(&self) -> Result<&dyn TaylorFunctions, TaylorUnsupported> {
         match &self.code.taylor {
             Ok(_) => Ok(Recurrences::of(self)),

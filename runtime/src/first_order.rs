@@ -734,6 +734,10 @@ fn taylor_branch_step<S: DynMechanicalSystem + ?Sized>(
     order: usize,
     h: f64,
 ) -> f64 {
+    // Most models have no root or real power: nothing to look up.
+    if !workspace.has_branch_points() {
+        return h;
+    }
     match taylor_support(system, stabilization) {
         Ok(taylor) => crate::taylor::branch_step(taylor.program(), workspace, order, h),
         Err(_) => h,

@@ -643,6 +643,8 @@ pub struct TaylorWorkspace {
     /// pivots are positive, the rest negative, so the same bits factor otherwise for another
     /// `n`.
     coordinates: usize,
+    /// Whether the program of the last series has ops whose branch [`branch_step`] checks.
+    branch_points: bool,
 }
 
 /// Two values side by side, aligned for one 16-byte load: the unit of the scratch a run-time
@@ -655,6 +657,13 @@ impl TaylorWorkspace {
     /// Empty buffers.
     pub fn new() -> Self {
         Self::default()
+    }
+
+    /// Whether the program of the last [`series_of_motion`] into this workspace has square
+    /// roots or real powers whose branch [`branch_step`] checks (`false` before any series):
+    /// without, `branch_step` returns the step it is given, and a step need not ask.
+    pub fn has_branch_points(&self) -> bool {
+        self.branch_points
     }
 
     /// Buffers for `order`: grown when a higher order or another program asks for more,
@@ -695,6 +704,7 @@ impl TaylorWorkspace {
             self.factored_values.clear();
         }
         self.coordinates = program.coordinates.len();
+        self.branch_points = !program.derived.branch_points.is_empty();
         self.lower.resize(n * n, 0.0);
         self.pivots.resize(n, 0.0);
         self.inverse_pivots.resize(n, 0.0);
