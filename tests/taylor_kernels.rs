@@ -2,7 +2,7 @@
 //! `tests/data/taylor_kernels.json`, written by `tools/taylor_kernel_reference.py` (see its
 //! docstring to regenerate it).
 //!
-//! The kernels (`runtime/src/taylor.rs`, reached through [`eomgen::taylor::apply`]) are the
+//! The kernels (`runtime/src/taylor/kernels.rs`, reached through [`eomgen::taylor::apply`]) are the
 //! recurrences of Jorba & Zou, *A software package for the numerical integration of ODEs by
 //! means of high-order Taylor methods*, Exp. Math. 14(1) (2005), §2, with the hidden partners
 //! of heyoka's `doc/ad_notes.rst` (Biscani & Izzo 2021). The bundled models rarely reach most
@@ -46,7 +46,7 @@ struct Reference {
 #[derive(Deserialize, Clone)]
 struct Case {
     name: String,
-    /// The kernel function of `runtime/src/taylor.rs` the op reaches (`tan_or_tanh`, …).
+    /// The kernel function of `runtime/src/taylor/kernels.rs` the op reaches (`tan_or_tanh`, …).
     kernel: String,
     /// The [`SeriesOp`] variant (`Acos` for `SeriesOp::Asin { acos: true, .. }`).
     op: String,

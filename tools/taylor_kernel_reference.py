@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """High-precision reference series for the Taylor-recurrence kernels of `eomgen::taylor`.
 
-`runtime/src/taylor.rs` computes the Taylor coefficients `f^[k]` (the coefficient of tau^k,
+`runtime/src/taylor/kernels.rs` computes the Taylor coefficients `f^[k]` (the coefficient of tau^k,
 i.e. f^(k)(0)/k!) of `f(a(tau))` order by order from those of its operands, by the recurrences
 of Jorba & Zou (2005, section 2) and heyoka's `doc/ad_notes.rst` (one kernel per `SeriesOp`).
 This script writes `tests/data/taylor_kernels.json`, which `tests/taylor_kernels.rs` reads to

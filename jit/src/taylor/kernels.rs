@@ -408,7 +408,7 @@ impl Emitter<'_> {
 
     /// Order `k ≥ 1` of `op`: the kernel of `eomgen_runtime::taylor` of its kind.
     // Long: one arm per op kind, each that op's kernel beside the others (as
-    // runtime/src/taylor.rs's kernels); split, the arms would only move into as many one-use
+    // runtime/src/taylor/kernels.rs's kernels); split, the arms would only move into as many one-use
     // functions.
     pub(super) fn op(&mut self, b: &mut FunctionBuilder, op: SeriesOp, k: usize) {
         let kf = k as f64;
