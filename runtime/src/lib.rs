@@ -37,12 +37,12 @@
 /// has AVX2 and FMA — the same body compiled a second time with those instruction sets
 /// enabled. The body is inlined into both copies (functions it calls that are not inlined run
 /// their one copy, compiled for any x86-64); both compute the same bits (see
-/// `host_features`). For the Taylor method's hot functions.
+/// `host_features`). The choice between them is inlined into the caller and each copy is out
+/// of line, so a call of `$name` on a processor with AVX2 is one call, not a call of a function
+/// that calls the copy. For the Taylor method's hot functions.
 macro_rules! with_host_features {
     ($(#[$meta:meta])* $vis:vis fn $name:ident($($arg:ident: $ty:ty),* $(,)?) $(-> $ret:ty)? $body:block) => {
         $(#[$meta])*
-        // The choice in line in the caller, each copy out of line: one call, not a call of a
-        // function that calls the copy.
         #[inline(always)]
         $vis fn $name($($arg: $ty),*) $(-> $ret)? {
             #[inline(always)]

@@ -1,5 +1,6 @@
-//! The branch check of a step ([`branch_step`](super::branch_step)): square roots and real powers whose argument
-//! may reach 0 within the step, where the series would continue past the branch point.
+//! The branch check of a step ([`branch_step`](super::branch_step)): square roots and real
+//! powers whose argument may reach 0 within the step, where the series would continue past
+//! the branch point.
 
 use eomgen_description::taylor::{SeriesOp, Slot, TaylorProgram};
 
@@ -89,12 +90,12 @@ enum Argument {
     OneMinusSquare(Slot),
 }
 
-/// [`branch_step`]'s samples of `f = g^α` (`out`, its `argument` and `α`) over `[0, limit]`
-/// in `series` (stride `c`, orders to `degree`): the first point where `f` or `g` has left
-/// its sign, or `f` is no longer `g^α` to 10⁻³, or either is not finite (bisected to `limit /
+/// [`branch_step`](super::branch_step)'s samples of `f = g^α` (`out`, its `argument` and `α`) over
+/// `[0, limit]` in `series` (stride `c`, orders to `degree`): the first point where `f` or `g` has
+/// left its sign, or `f` is no longer `g^α` to 10⁻³, or either is not finite (bisected to `limit /
 /// 2³⁴`); `None` where every sample is on the branch, or where the argument at `τ = 0` is not
-/// positive (NaN included). A function of its own, out of line, so that the loop over the
-/// points, which the usual step leaves without a sample, keeps its registers.
+/// positive (NaN included). A function of its own, out of line, so that the loop over the points,
+/// which the usual step leaves without a sample, keeps its registers.
 #[cold]
 #[inline(never)]
 fn first_off_branch(

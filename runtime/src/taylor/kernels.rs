@@ -1,7 +1,7 @@
-//! The recurrence of each op of a [`TaylorProgram`] (its kernel: order `k` of the op's
-//! value from the orders below `k` of its operands) and [`evaluate_order`], which runs a
-//! program's ops one order at a time. The `model!` macro's code calls the kernels op by op
-//! with its slots as constants; a run-time model reaches them through [`apply`].
+//! The recurrence of each op of a [`TaylorProgram`](super::TaylorProgram) (its kernel: order `k` of
+//! the op's value from the orders below `k` of its operands) and [`evaluate_order`], which runs a
+//! program's ops one order at a time. The `model!` macro's code calls the kernels op by op with its
+//! slots as constants; a run-time model reaches them through [`apply`].
 //!
 //! Source: Jorba & Zou (2005), §2; Biscani & Izzo (2021) and heyoka's `doc/ad_notes.rst`.
 

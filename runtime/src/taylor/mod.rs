@@ -2,11 +2,11 @@
 //! order, and `M q̈ = F` solved as a series (with `m` constraints, the index-1 system
 //! `[M Jᵀ; J 0][q̈; λ] = [F; γ]`, its `n + m` unknowns in place of `q̈`'s `n`, the same way).
 //!
-//! Rooms: the kernel of each op and their dispatch (`kernels`), the series solve of
-//! `M q̈ = F` order by order (`motion`), the branch check of a step (`branch`), and here the
+//! Rooms: where a slot's orders live, the helpers every kernel inlines (`known`, `at`, `put`,
+//! `series`) and the list of the orders compiled with `k` known (`unrolled_orders!`) in
+//! `slots`; the kernel of each op and their dispatch in `kernels`; the series solve of
+//! `M q̈ = F` order by order in `motion`; the branch check of a step in `branch`; and here the
 //! workspace, the [`TaylorFunctions`] a model hands out and [`series_of_motion`], which runs
-//! them. The helpers every kernel inlines (`known`, `at`, `put`, `series`) and the list of
-//! the orders compiled with `k` known (`unrolled_orders!`) are here, above the rooms that use
 //! them.
 //!
 //! With `x(t₀ + τ) = Σₖ x^[k] τᵏ` for every value of the model's program, the state
@@ -164,10 +164,11 @@ impl TaylorWorkspace {
         Self::default()
     }
 
-    /// Whether the program of the last [`series_of_motion`] into this workspace has square
-    /// roots or real powers whose branch [`branch_step`] checks (`false` before any series):
-    /// without, `branch_step` returns the step it is given, and a step need not ask.
-    pub fn has_branch_points(&self) -> bool {
+    /// Whether the program of the last [`series_of_motion`] into this workspace has ops whose
+    /// branch [`branch_step`] checks (square roots, powers with a constant exponent, `asin`
+    /// and `acos`; `false` before any series): without, `branch_step` returns the step it is
+    /// given, and a step need not ask.
+    pub(crate) fn has_branch_points(&self) -> bool {
         self.branch_points
     }
 

@@ -12,15 +12,15 @@ use eomgen_description::taylor::{Slot, UNROLLED_CAPACITY, UNROLLED_ORDERS};
 #[repr(C, align(16))]
 pub struct Lanes(pub [f64; 2]);
 
-/// Where [`motion_order`] finds the series of `F`, of the entries of `M` that vary and of
-/// the accelerations, and where it writes the state's next order: the same lists for a
-/// program whether the run-time [`series_of_motion`](super::series_of_motion) builds them from the program or the
-/// `model!` macro prints them as constants (so that the compiler folds the loops over them
-/// into straight-line code).
+/// Where [`motion_order`] finds the series of `F`, of the entries of `M` that vary and of the
+/// accelerations, and where it writes the state's next order: the same lists for a program whether
+/// the run-time [`series_of_motion`](super::series_of_motion) builds them from the program or the
+/// `model!` macro prints them as constants (so that the compiler folds the loops over them into
+/// straight-line code).
 #[derive(Debug, Clone, Copy)]
 pub struct MotionLayout<'a> {
-    /// `F`'s slots ([`TaylorProgram::forcing`](super::TaylorProgram::forcing)), one per coordinate, then `γ`'s, one per
-    /// constraint.
+    /// `F`'s slots ([`TaylorProgram::forcing`](super::TaylorProgram::forcing)), one per coordinate,
+    /// then `γ`'s, one per constraint.
     pub forcing: &'a [Slot],
     /// [`DerivedLists::varying_mass_entries`](super::DerivedLists::varying_mass_entries).
     pub coupled: &'a [(u32, u32, Slot)],
@@ -32,8 +32,9 @@ pub struct MotionLayout<'a> {
     pub accelerations: Slot,
 }
 
-/// `M⁰`'s factor and the stride of one [`series_of_motion`](super::series_of_motion), for [`motion_order`], and the
-/// workspace's scratch for a run-time backend's compiled orders ([`Self::lanes`]).
+/// `M⁰`'s factor and the stride of one [`series_of_motion`](super::series_of_motion), for
+/// [`motion_order`], and the workspace's scratch for a run-time backend's compiled orders
+/// ([`Self::lanes`]).
 #[derive(Debug)]
 pub struct MotionSolve<'a> {
     /// The unknowns of each order: `n` accelerations, then `m` multipliers.

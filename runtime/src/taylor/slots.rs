@@ -11,11 +11,11 @@ pub(super) fn series(s: &[f64], capacity: usize, slot: Slot) -> &[f64] {
     &s[start..start + capacity]
 }
 
-/// `$m!($($arg)*; 1 2 … 19)`: the orders compiled with `k` known ([`UNROLLED_ORDERS`]), one
-/// list for every dispatch on the order.
+/// `$m!($($arg)*; 1 2 … 19)`: the orders compiled with `k` known
+/// ([`UNROLLED_ORDERS`](super::UNROLLED_ORDERS)), one list for every dispatch on the order.
 macro_rules! unrolled_orders {
     ($m:ident $(, $arg:tt)*) => {{
-        const _: () = assert!(UNROLLED_ORDERS == 19);
+        const _: () = assert!($crate::taylor::UNROLLED_ORDERS == 19);
         $m!($($arg)*; 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19)
     }};
 }
@@ -24,9 +24,11 @@ macro_rules! unrolled_orders {
 /// 0, else `(k, c)`.
 ///
 /// [`evaluate_order`](super::evaluate_order) (the run-time model's orders) and the `model!`
-/// macro's `TaylorFunctions::orders` in optimised builds pick `K = k` for `k ≤` [`UNROLLED_ORDERS`]
-/// when the workspace's stride is [`UNROLLED_CAPACITY`] (as [`series_of_motion`](super::series_of_motion)'s is when
-/// [`TaylorProgram::unrolled_code_fits`], or the model has fused orders): the sums then have
+/// macro's `TaylorFunctions::orders` in optimised builds pick `K = k` for
+/// `k ≤` [`UNROLLED_ORDERS`](super::UNROLLED_ORDERS) when the workspace's stride is
+/// [`UNROLLED_CAPACITY`] (as [`series_of_motion`](super::series_of_motion)'s is when
+/// [`TaylorProgram::unrolled_code_fits`](super::TaylorProgram::unrolled_code_fits), or the
+/// model has fused orders): the sums then have
 /// a known number of terms and unroll into straight-line code, and every coefficient is at
 /// a known offset, so the compiler passes an op's result to the next in a register instead
 /// of through memory. Both variants run the same operations in the same order, so they
