@@ -6,7 +6,7 @@
 //! Source: Jorba & Zou (2005), §2; Biscani & Izzo (2021) and heyoka's `doc/ad_notes.rst`.
 
 use super::slots::{at, known, put, series};
-use eomgen_description::taylor::{SeriesOp, Slot, UNROLLED_CAPACITY, UNROLLED_ORDERS};
+use eomgen_description::taylor::{SeriesOp, Slot, UNROLLED_CAPACITY};
 use wide::f64x2;
 
 /// `Σ_{j=from}^{to} a[j] b[k − j]` (`from ≤ to ≤ k`), in increasing `j`.

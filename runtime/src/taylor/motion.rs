@@ -4,7 +4,7 @@
 
 use super::slots::{at, known, put, series};
 use crate::ode::RhsError;
-use eomgen_description::taylor::{Slot, UNROLLED_CAPACITY, UNROLLED_ORDERS};
+use eomgen_description::taylor::{Slot, UNROLLED_CAPACITY};
 
 /// Two values side by side, aligned for one 16-byte load: the unit of the scratch a run-time
 /// backend's compiled orders keep between orders ([`MotionSolve::lanes`]).
