@@ -438,8 +438,8 @@ pub fn zero<const K: usize>(k: usize, c: usize, s: &mut [f64], out: Slot) {
 }
 
 /// Order `k ≥ 1` of every series of `ops`, in order ([`apply`] for each): the run-time
-/// model's orders, compiled for `K = k` when `k ≤` [`UNROLLED_ORDERS`] and `capacity` is
-/// [`UNROLLED_CAPACITY`], else for any order.
+/// model's orders, compiled for `K = k` when `k ≤` [`UNROLLED_ORDERS`](super::UNROLLED_ORDERS)
+/// and `capacity` is [`UNROLLED_CAPACITY`], else for any order.
 pub fn evaluate_order(ops: &[SeriesOp], k: usize, capacity: usize, s: &mut [f64]) {
     /// The ops for one `K`, out of line (one variant per order).
     #[inline(never)]
