@@ -427,6 +427,33 @@ fn factor(
             return Ok(());
         }
     }
+    // The loops below with `n` a constant for the usual sizes, so that they unroll (the same
+    // operations in the same order; the loops over any `n` took 328 instructions a step for
+    // the heavy top's 3 × 3 `M`).
+    match n {
+        3 => factor_loops(3, positive, m, lower, pivots, inverse_pivots),
+        4 => factor_loops(4, positive, m, lower, pivots, inverse_pivots),
+        5 => factor_loops(5, positive, m, lower, pivots, inverse_pivots),
+        6 => factor_loops(6, positive, m, lower, pivots, inverse_pivots),
+        _ => factor_loops(n, positive, m, lower, pivots, inverse_pivots),
+    }
+}
+
+/// [`factor`]'s loops (`L D Lᵀ` column by column), in line in each of its size's copies.
+#[inline(always)]
+fn factor_loops(
+    n: usize,
+    positive: usize,
+    m: impl Fn(usize, usize) -> f64,
+    lower: &mut [f64],
+    pivots: &mut [f64],
+    inverse_pivots: &mut [f64],
+) -> Result<(), usize> {
+    let (lower, pivots, inverse_pivots) = (
+        &mut lower[..n * n],
+        &mut pivots[..n],
+        &mut inverse_pivots[..n],
+    );
     for j in 0..n {
         let mut d = m(j, j);
         for k in 0..j {
