@@ -695,8 +695,8 @@ fn taylor_support<S: DynMechanicalSystem + ?Sized>(
     stabilization: Stabilization,
 ) -> Result<&dyn TaylorFunctions, TaylorUnsupported> {
     // The stabilization first: the model's description (a dynamic call) is read only when
-    // the stabilization has terms the recurrences lack (this runs twice a step: for the
-    // series and for the branch check).
+    // the stabilization has terms the recurrences lack (this runs once or twice a step: for
+    // the series, and for the branch check of a model that has branch points).
     if !matches!(
         stabilization,
         Stabilization::None | Stabilization::Projection
@@ -734,7 +734,8 @@ fn taylor_branch_step<S: DynMechanicalSystem + ?Sized>(
     order: usize,
     h: f64,
 ) -> f64 {
-    // Most models have no root or real power: nothing to look up.
+    // Most models have no op whose branch is checked (a root, a power with a constant
+    // exponent, `asin`, `acos`): nothing to look up.
     if !workspace.has_branch_points() {
         return h;
     }
