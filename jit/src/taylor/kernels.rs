@@ -394,9 +394,9 @@ impl Emitter<'_> {
             sum = b.ins().fadd(sum, term);
         }
         let (x0, xk) = (self.at(b, x, 0), self.at(b, x, k));
-        let product = b.ins().fmul(x0, xk);
         let two = self.constant(b, 2.0);
-        let last = b.ins().fmul(two, product);
+        let twice = b.ins().fmul(two, x0);
+        let last = b.ins().fmul(twice, xk);
         b.ins().fadd(sum, last)
     }
 
@@ -404,6 +404,14 @@ impl Emitter<'_> {
     pub(super) fn over_k(&self, b: &mut FunctionBuilder, v: ir::Value, k: usize) -> ir::Value {
         let r = self.constant(b, 1.0 / k as f64);
         b.ins().fmul(v, r)
+    }
+
+    /// The kernels' `over`: `n · (1/d)`, the reciprocal of a divisor formed from order-0
+    /// coefficients, so that only the multiplication waits for order `k`'s numerator.
+    pub(super) fn over(&self, b: &mut FunctionBuilder, n: ir::Value, d: ir::Value) -> ir::Value {
+        let one = self.constant(b, 1.0);
+        let r = b.ins().fdiv(one, d);
+        b.ins().fmul(n, r)
     }
 
     /// Order `k ≥ 1` of `op`: the kernel of `eomgen_runtime::taylor` of its kind.
@@ -449,7 +457,7 @@ impl Emitter<'_> {
                 let sum = self.sum_of_products(b, (y, out, k), 1..=k, false);
                 let (ak, y0) = (self.at(b, a, k), self.at(b, y, 0));
                 let d = b.ins().fsub(ak, sum);
-                let v = b.ins().fdiv(d, y0);
+                let v = self.over(b, d, y0);
                 self.put(b, out, k, v);
             }
             SeriesOp::DivByConstant { out, a, constant } => {
@@ -461,7 +469,7 @@ impl Emitter<'_> {
                 let sum = self.sum_of_products(b, (y, out, k), 1..=k, false);
                 let y0 = self.at(b, y, 0);
                 let minus = b.ins().fneg(sum);
-                let v = b.ins().fdiv(minus, y0);
+                let v = self.over(b, minus, y0);
                 self.put(b, out, k, v);
             }
             SeriesOp::Sqrt { out, a } => {
@@ -474,7 +482,7 @@ impl Emitter<'_> {
                 let d = b.ins().fsub(ak, sum);
                 let two = self.constant(b, 2.0);
                 let twice = b.ins().fmul(o0, two);
-                let v = b.ins().fdiv(d, twice);
+                let v = self.over(b, d, twice);
                 self.put(b, out, k, v);
             }
             SeriesOp::PowConstant { out, a, exponent } => {
@@ -492,7 +500,7 @@ impl Emitter<'_> {
                 }
                 let x0 = self.at(b, a, 0);
                 let d = b.ins().fmul(x0, kc);
-                let v = b.ins().fdiv(sum, d);
+                let v = self.over(b, sum, d);
                 self.put(b, out, k, v);
             }
             SeriesOp::Exp { out, a } => {
@@ -511,7 +519,7 @@ impl Emitter<'_> {
                 let kx = b.ins().fmul(xk, kc);
                 let n = b.ins().fsub(kx, sum);
                 let d = b.ins().fmul(x0, kc);
-                let v = b.ins().fdiv(n, d);
+                let v = self.over(b, n, d);
                 self.put(b, out, k, v);
             }
             SeriesOp::SinCos { sin, cos, a } => {
@@ -550,7 +558,7 @@ impl Emitter<'_> {
                 let n = b.ins().fsub(minus, sum);
                 let two = self.constant(b, 2.0);
                 let twice = b.ins().fmul(r0, two);
-                let rk = b.ins().fdiv(n, twice);
+                let rk = self.over(b, n, twice);
                 let sign = if acos { -1.0 } else { 1.0 };
                 let sum = if k > 1 {
                     self.sum_of_products(b, (out, root, k), 1..=k - 1, true)
@@ -563,7 +571,7 @@ impl Emitter<'_> {
                 let n = b.ins().fsub(sx, sum);
                 let kc = self.constant(b, kf);
                 let d = b.ins().fmul(r0, kc);
-                let v = b.ins().fdiv(n, d);
+                let v = self.over(b, n, d);
                 self.put(b, root, k, rk);
                 self.put(b, out, k, v);
             }
@@ -583,7 +591,7 @@ impl Emitter<'_> {
                 let sq0 = self.at(b, square, 0);
                 let s = b.ins().fadd(one, sq0);
                 let d = b.ins().fmul(s, kc);
-                let v = b.ins().fdiv(n, d);
+                let v = self.over(b, n, d);
                 self.put(b, out, k, v);
             }
             SeriesOp::Atan2 { out, y, x, norm } => {
@@ -603,7 +611,7 @@ impl Emitter<'_> {
                 let kc = self.constant(b, kf);
                 let n0 = self.at(b, norm, 0);
                 let d = b.ins().fmul(n0, kc);
-                let v = b.ins().fdiv(n, d);
+                let v = self.over(b, n, d);
                 self.put(b, out, k, v);
             }
             SeriesOp::Zero { out } => {
@@ -635,7 +643,7 @@ impl Emitter<'_> {
     }
 
     /// A term `(kα − j(α + 1)) x[k − j] y[j]` of the power with constant exponent `α`, as
-    /// the kernel `pow_constant` computes it.
+    /// the kernel `pow_constant` computes it (for `j = 0`, `x[k] (kα y[0])`).
     pub(super) fn power_term(
         &self,
         b: &mut FunctionBuilder,
@@ -643,6 +651,18 @@ impl Emitter<'_> {
         xv: ir::Value,
         ov: ir::Value,
     ) -> ir::Value {
+        if j == 0 {
+            // The term with order k: `x[k] (kα o[0])`, as the kernel forms it.
+            let weight = match self.layout.constants.get(&exponent) {
+                Some(&alpha) => self.constant(b, k as f64 * alpha),
+                None => {
+                    let kc = self.constant(b, k as f64);
+                    b.ins().fmul(kc, alpha)
+                }
+            };
+            let t = b.ins().fmul(weight, ov);
+            return b.ins().fmul(xv, t);
+        }
         if let Some(&alpha) = self.layout.constants.get(&exponent) {
             // The same operations in Rust, so the same bits.
             let weight = alpha * k as f64 - (alpha + 1.0) * j as f64;
