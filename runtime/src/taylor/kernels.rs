@@ -212,8 +212,9 @@ pub fn scale<const K: usize>(
 /// Order `k`'s numerator waits for the operands' order `k`, its divisor does not, so the
 /// division runs beside the numerator's sum and only a multiplication stays on the path from
 /// one order to the next (about 4 cycles instead of 13–14 on x86-64). On the Kepler orbit and
-/// the central force, whose `r⁻³` is a power on that path, whole runs took 0.93–0.94 of the
-/// time at tolerances 1e-6 to 1e-12 (docs/performance.md). Two roundings instead of one: the
+/// the central force, whose `r⁻³` is a power on that path, whole runs took 0.90–0.92 of the
+/// time at tolerances 1e-6 to 1e-12, with the square's and the power's last terms below
+/// (docs/performance.md, "What heyoka executes a step"). Two roundings instead of one: the
 /// quotient is within 1.5 ulp rather than 0.5, far inside the truncation error of the series.
 /// The run-time compiler's kernels (`eomgen_jit`) form it the same way, so both give these
 /// bits.
