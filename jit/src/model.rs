@@ -6,8 +6,8 @@ use std::sync::{Arc, Mutex, OnceLock};
 
 use eomgen_runtime::dynamic::{rates_are_the_state, rates_are_the_state_jacobian};
 use eomgen_runtime::taylor::{
-    DerivedLists, MotionLayout, MotionSolve, TaylorFunctions, TaylorProgram, TaylorUnsupported,
-    UNROLLED_CAPACITY,
+    DerivedLists, FactorForm, MotionLayout, MotionSolve, TaylorFunctions, TaylorProgram,
+    TaylorUnsupported, UNROLLED_CAPACITY,
 };
 use eomgen_runtime::{DynMechanicalSystem, ModelDescription, UnknownParameter};
 use eomgen_symbolic::codegen::GenerateError;
@@ -840,23 +840,25 @@ impl TaylorFunctions for Recurrences {
         }
         // With a diagonal factor, or any of `n ≤ 6`, the code solves in line (the same
         // operations as `motion_order`'s), else it calls `solve_order`.
-        let (lower, inverse_pivots, mode) = match (solve.small_factor(), solve.diagonal_factor()) {
-            (_, Some(inverse)) if inverse.len() == n => {
+        let (lower, inverse_pivots, mode) = match solve.factor_form() {
+            FactorForm::Diagonal(inverse) if inverse.len() == n => {
                 (std::ptr::null(), inverse.as_ptr(), FACTOR_DIAGONAL)
             }
-            (Some((lower, inverse)), _) if lower.len() == n * n && inverse.len() == n => {
-                let mode = if solve.dense_factor().is_some() {
-                    FACTOR_DENSE
-                } else {
-                    FACTOR_SMALL
-                };
-                (lower.as_ptr(), inverse.as_ptr(), mode)
+            FactorForm::Dense(lower, inverse) if lower.len() == n * n && inverse.len() == n => {
+                (lower.as_ptr(), inverse.as_ptr(), FACTOR_DENSE)
+            }
+            FactorForm::Small(lower, inverse) if lower.len() == n * n && inverse.len() == n => {
+                (lower.as_ptr(), inverse.as_ptr(), FACTOR_SMALL)
             }
             _ => (std::ptr::null(), std::ptr::null(), 0),
         };
         // The scratch of the workspace, kept between steps.
         let scratch = solve.lanes(orders.scratch_units).as_mut_ptr();
-        let mut context = OrderContext {
+        let (series_len, out_len) = (series.len(), out.len());
+        let (series, out) = (series.as_mut_ptr(), out.as_mut_ptr());
+        // What `solve_order` needs, only where the code calls it (the factors solved in line
+        // never do): built at every step, it was about 25 stores.
+        let mut context = (mode == 0).then(|| OrderContext {
             layout: MotionLayout {
                 forcing: &program.forcing,
                 coupled: &program.derived.varying_mass_entries,
@@ -865,14 +867,15 @@ impl TaylorFunctions for Recurrences {
                 accelerations: program.acceleration_slot(),
             },
             solve,
-            series: series.as_mut_ptr(),
-            series_len: series.len(),
-            out: out.as_mut_ptr(),
-            out_len: out.len(),
-        };
-        let (series, out) = (context.series, context.out);
+            series,
+            series_len,
+            out,
+            out_len,
+        });
         let frame = OrderFrame {
-            context: (&raw mut context).cast::<u8>(),
+            context: context.as_mut().map_or(std::ptr::null_mut(), |context| {
+                (&raw mut *context).cast::<u8>()
+            }),
             solve: solve_order,
             lower,
             inverse_pivots,
@@ -882,8 +885,9 @@ impl TaylorFunctions for Recurrences {
             // SAFETY: `series` holds every slot at the stride of 25 with the orders below `k`
             // computed (by the calls before this one), and `out` every order the code writes
             // (checked above); `frame`'s `lower` and `inverse_pivots`, when not null, hold
-            // `n × n` and `n` values that nothing writes during the call, and `solve_order`
-            // is called with the context built for it; `scratch` holds the units the orders
+            // `n × n` and `n` values that nothing writes during the call, and the code calls
+            // `solve_order` only with `factor` 0, for which the context is built (not null);
+            // `scratch` holds the units the orders
             // use, with the orders below `k` written by the calls before, and nothing
             // `solve_order` reaches (`motion_order_at`) touches the workspace's lanes, so
             // they are not reallocated under the code; `series`, `out`, `scratch` and `frame`

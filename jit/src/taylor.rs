@@ -119,7 +119,8 @@ pub(crate) type OrderFn =
 #[derive(Debug)]
 #[repr(C)]
 pub(crate) struct OrderFrame {
-    /// What `solve` is called with.
+    /// What `solve` is called with: null when `factor` names a factor solved in line, whose
+    /// code never calls it.
     pub(crate) context: *mut u8,
     /// Order `k`'s solve when the code does not solve in line: 0, or a failure's status.
     pub(crate) solve: extern "C" fn(*mut u8, usize) -> u8,

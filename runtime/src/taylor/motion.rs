@@ -72,42 +72,44 @@ impl MotionSolve<'_> {
         self.c == UNROLLED_CAPACITY
     }
 
-    /// `(L, D⁻¹)` (`L` row-major `n × n`, unit diagonal implied) when [`motion_order`] solves
-    /// with them as a dense factor in registers — `n ≤ 6` and no zero below `L`'s diagonal —
-    /// for a run-time backend that does the same: `L z = b` row by row, `z ← D⁻¹ z`, then
-    /// `Lᵀ x = z` from the last row up; `None` when it solves over `L`'s non-zero entries.
-    #[inline]
-    pub fn dense_factor(&self) -> Option<(&[f64], &[f64])> {
-        (self.n <= FIXED_DEGREES && self.dense).then(|| {
-            (
-                &self.lower[..self.n * self.n],
-                &self.inverse_pivots[..self.n],
-            )
-        })
+    /// How [`motion_order`] solves with the step's factor, for a run-time backend that does
+    /// the same in its own code ([`FactorForm`]): one test of the factor's shape a step.
+    #[inline(always)]
+    pub fn factor_form(&self) -> FactorForm<'_> {
+        let n = self.n;
+        if n == self.coordinates {
+            if self.nonzeros.is_empty() {
+                return FactorForm::Diagonal(&self.inverse_pivots[..n]);
+            }
+            if n <= FIXED_DEGREES {
+                let factor = (&self.lower[..n * n], &self.inverse_pivots[..n]);
+                return if self.dense {
+                    FactorForm::Dense(factor.0, factor.1)
+                } else {
+                    FactorForm::Small(factor.0, factor.1)
+                };
+            }
+        }
+        FactorForm::General
     }
+}
 
-    /// `(L, D⁻¹)` as [`Self::dense_factor`] gives them, for any `L` with `n ≤ 6` — with zeros
-    /// below its diagonal too, whose updates a run-time backend that solves with it must skip
-    /// (as [`motion_order`]'s solve over `L`'s non-zero entries does: `b − 0·x` is not `b` for
-    /// `b = −0` or `x` infinite); `None` for larger `n`.
-    #[inline]
-    pub fn small_factor(&self) -> Option<(&[f64], &[f64])> {
-        (self.n <= FIXED_DEGREES && self.n == self.coordinates).then(|| {
-            (
-                &self.lower[..self.n * self.n],
-                &self.inverse_pivots[..self.n],
-            )
-        })
-    }
-
-    /// `D⁻¹` when `L` is the identity (no non-zero entry below its diagonal: a diagonal `M`),
-    /// whose solve is then `x = D⁻¹ b` alone, for a run-time backend that does the same;
-    /// `None` otherwise.
-    #[inline]
-    pub fn diagonal_factor(&self) -> Option<&[f64]> {
-        (self.nonzeros.is_empty() && self.n == self.coordinates)
-            .then(|| &self.inverse_pivots[..self.n])
-    }
+/// The shape of the step's factor `M⁰ = L D Lᵀ` ([`MotionSolve::factor_form`]), as
+/// [`motion_order`] solves with it: `L z = b` row by row, `z ← D⁻¹ z`, then `Lᵀ x = z` from
+/// the last row up. `L` is row-major `n × n` with its unit diagonal implied, `D⁻¹` has `n`
+/// values.
+#[derive(Debug, Clone, Copy)]
+pub enum FactorForm<'a> {
+    /// `L` is the identity (a diagonal `M`, no constraints): `x = D⁻¹ b` alone.
+    Diagonal(&'a [f64]),
+    /// `(L, D⁻¹)` with no zero below `L`'s diagonal and `n ≤ 6`: solved in registers.
+    Dense(&'a [f64], &'a [f64]),
+    /// `(L, D⁻¹)` with zeros below `L`'s diagonal and `n ≤ 6`, whose updates a backend must
+    /// skip, as the solve over `L`'s non-zero entries does (`b − 0·x` is not `b` for `b = −0`
+    /// or `x` infinite).
+    Small(&'a [f64], &'a [f64]),
+    /// Any other: more unknowns, or constraints ([`motion_order_at`]).
+    General,
 }
 
 /// The largest `n` whose solves [`motion_order`] compiles for a known `n` (dense `L` in
@@ -377,6 +379,14 @@ pub(super) fn factor_mass(
         }
     })?;
     nonzeros.clear();
+    if n == 2 {
+        // Two unknowns (the closed form's): the one entry below the diagonal, without the
+        // loops' bookkeeping (41 instructions a step on the double pendulum).
+        if lower[2] != 0.0 {
+            nonzeros.push((1, 0, lower[2]));
+        }
+        return Ok(());
+    }
     for i in 0..n {
         for (j, &l) in lower[i * n..i * n + i].iter().enumerate() {
             if l != 0.0 {
