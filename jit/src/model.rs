@@ -886,7 +886,8 @@ impl TaylorFunctions for Recurrences {
             // computed (by the calls before this one), and `out` every order the code writes
             // (checked above); `frame`'s `lower` and `inverse_pivots`, when not null, hold
             // `n × n` and `n` values that nothing writes during the call, and the code calls
-            // `solve_order` only with `factor` 0, for which the context is built (not null);
+            // `solve_order` only with `factor` 0 (every constrained model's), for which the
+            // context is built (`solve_order` refuses a null one);
             // `scratch` holds the units the orders
             // use, with the orders below `k` written by the calls before, and nothing
             // `solve_order` reaches (`motion_order_at`) touches the workspace's lanes, so
@@ -926,6 +927,12 @@ struct OrderContext<'a, 'b> {
 /// stop and report none computed, and the step computes them again by the runtime's
 /// kernels: a panic must not unwind through the compiled code).
 extern "C" fn solve_order(context: *mut u8, k: usize) -> u8 {
+    // Built only for the factors the code does not solve in line (`orders`), which include
+    // every constrained model's; a call without it is refused, and the step computes its
+    // orders by the runtime's kernels.
+    if context.is_null() {
+        return 1;
+    }
     let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
         // SAFETY: `context` is the `OrderContext` of the `orders` call in progress,
         // whose `series` and `out` are exclusively lent to this call chain.

@@ -372,7 +372,7 @@ impl Emitter<'_> {
         b.ins().fadd(sum, last)
     }
 
-    /// The kernels' `square`: `(2 h + [k even] x[k/2]²) + 2 (x[0] x[k])`, `h` the sum of
+    /// The kernels' `square`: `(2 h + [k even] x[k/2]²) + (2 x[0]) x[k]`, `h` the sum of
     /// `x[j] x[k − j]` for `j = 1 … ⌊(k − 1)/2⌋` (started by [`Self::prefixes`]).
     pub(super) fn square(&mut self, b: &mut FunctionBuilder, x: Slot, k: usize) -> ir::Value {
         let half = match self.started(b, Sum::Square { x }, self.ty()) {

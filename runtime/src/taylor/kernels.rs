@@ -178,7 +178,7 @@ pub fn mul<const K: usize>(k: usize, c: usize, s: &mut [f64], out: Slot, a: Slot
 /// formed once, `(2 h + [k even] a[k/2]²) + (2 a[0]) a[k]` with `h = Σ_{j=1}^{⌊(k−1)/2⌋}
 /// a[j] a[k − j]` in increasing `j`; the term that holds order `k` last, as in [`cauchy`],
 /// with `2 a[0]` formed before `a[k]` is known (one multiplication after it instead of two;
-/// the same value as `2 (a[0] a[k])` unless that product is subnormal).
+/// the same value as `2 (a[0] a[k])` unless that product is subnormal or `2 a[0]` overflows).
 /// (Jorba & Zou 2005, §2.1; heyoka's `square`.) Half the products of the Cauchy product
 /// (a sixth of the figure eight's products at order 12 are squares' halves).
 #[inline(always)]
@@ -215,7 +215,10 @@ pub fn scale<const K: usize>(
 /// the central force, whose `r⁻³` is a power on that path, whole runs took 0.90–0.92 of the
 /// time at tolerances 1e-6 to 1e-12, with the square's and the power's last terms below
 /// (docs/performance.md, "What heyoka executes a step"). Two roundings instead of one: the
-/// quotient is within 1.5 ulp rather than 0.5, far inside the truncation error of the series.
+/// quotient is within 1.5 ulp rather than 0.5, far inside the truncation error of the series,
+/// while `1/d` is a normal number (`|d|` between about 2⁻¹⁰²⁴ and 2¹⁰²²; beyond, `1/d` is
+/// infinite or subnormal, and a zero numerator over a tiny divisor gives NaN, which fails the
+/// step, where the division gave 0).
 /// The run-time compiler's kernels (`eomgen_jit`) form it the same way, so both give these
 /// bits.
 #[inline(always)]
