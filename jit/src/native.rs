@@ -737,6 +737,25 @@ impl Emitter<'_, '_> {
         }
     }
 
+    /// The buffer and byte offset of tape values `first` and `second` when they are inputs
+    /// one after the other in one buffer, else `None`.
+    fn adjacent_inputs(&self, first: u32, second: u32) -> Option<(ir::Value, i32)> {
+        let input = |x: u32| match self.tape.instructions[x as usize] {
+            Instruction::Input(input) => Some(input),
+            _ => None,
+        };
+        let a = &self.arguments;
+        let (base, offset, i, j) = match (input(first)?, input(second)?) {
+            (Input::Parameter(i), Input::Parameter(j)) => (a.parameters, 0, i, j),
+            (Input::Coordinate(i), Input::Coordinate(j)) => (a.q, 0, i, j),
+            (Input::Velocity(i), Input::Velocity(j)) => (a.qdot, a.qdot_offset, i, j),
+            (Input::Acceleration(i), Input::Acceleration(j)) => (a.acceleration, 0, i, j),
+            (Input::Multiplier(i), Input::Multiplier(j)) => (a.lambda, 0, i, j),
+            _ => return None,
+        };
+        (j == i + 1).then_some((base, offset + (i as i32) * 8))
+    }
+
     /// Stores the outputs of a small function two at a time (slots 2k and 2k + 1 of a buffer
     /// as one 16-byte store): the caller reads them back at once, often 16 bytes at a time
     /// (nalgebra's copies, the solve of `M q̈ = F`), and a 16-byte load of two 8-byte stores
@@ -763,6 +782,24 @@ impl Emitter<'_, '_> {
                         continue;
                     }
                     _ => {}
+                }
+                if let [first, second] = *chunk
+                    && let Some((input, at)) = self.adjacent_inputs(first, second)
+                {
+                    // Two inputs side by side (a first-order function's `q̇`, the first half
+                    // of its `ẏ`): one 16-byte load rather than two loads and the two
+                    // instructions that pair them. Not `aligned`: `q̇` starts 8 bytes into a
+                    // buffer for odd `n`.
+                    let vector = self.b.ins().load(
+                        types::F64X2,
+                        MemFlagsData::new().with_notrap(),
+                        input,
+                        at,
+                    );
+                    self.b
+                        .ins()
+                        .store(MemFlagsData::trusted(), vector, base, offset);
+                    continue;
                 }
                 let first = self.value(chunk[0]);
                 match chunk.get(1) {
