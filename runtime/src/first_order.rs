@@ -176,6 +176,11 @@ impl<S: MechanicalSystem<N>, const N: usize> OdeSystem for FirstOrder<S, N> {
         Ok(())
     }
 
+    /// Only a constrained model projected after each step ([`Stabilization::Projection`]).
+    fn corrects_state(&self) -> bool {
+        !self.constraints.is_empty() && self.stabilization == Stabilization::Projection
+    }
+
     fn after_step(&mut self, t: f64, y: &mut [f64]) -> Result<bool, RhsError> {
         if self.constraints.is_empty() || self.stabilization != Stabilization::Projection {
             return Ok(false);
@@ -561,6 +566,11 @@ impl<S: DynMechanicalSystem> OdeSystem for DynFirstOrder<S> {
         self.generalized_accelerations(q, qdot, t, acceleration)?;
         velocity.copy_from_slice(qdot);
         Ok(())
+    }
+
+    /// Only a constrained model projected after each step ([`Stabilization::Projection`]).
+    fn corrects_state(&self) -> bool {
+        !self.constraints.is_empty() && self.stabilization == Stabilization::Projection
     }
 
     fn after_step(&mut self, t: f64, y: &mut [f64]) -> Result<bool, RhsError> {

@@ -115,6 +115,15 @@ pub trait OdeSystem {
         Ok(false)
     }
 
+    /// Whether [`Self::after_step`] can change a state, asked once at the start of each
+    /// integration. `false` lets the integrators skip the call after every step, with the copy
+    /// of the state it is given (about 50 instructions a step on the double pendulum, 1–2 % of
+    /// a Taylor step at 10⁻⁴). The default, `true`, always calls it: a system whose
+    /// `after_step` never changes the state may say `false`.
+    fn corrects_state(&self) -> bool {
+        true
+    }
+
     /// The event functions `gᵢ(t, y)` whose zeros every integrator locates, with their names,
     /// directions and whether they stop the integration ([`Solution::events`](crate::Solution::events));
     /// none by default.
@@ -317,6 +326,10 @@ where
 
     fn after_step(&mut self, t: f64, y: &mut [f64]) -> Result<bool, RhsError> {
         self.system.after_step(t, y)
+    }
+
+    fn corrects_state(&self) -> bool {
+        self.system.corrects_state()
     }
 
     fn event_specs(&self) -> &[EventSpec] {

@@ -703,6 +703,9 @@ fn project_samples(
     solution: &mut Solution,
     first_sample: usize,
 ) -> Result<(), StepFailure> {
+    if !rhs.corrects_state() {
+        return Ok(());
+    }
     let dim = corrected.len();
     for i in first_sample..solution.t.len() {
         let row = &mut solution.y[i * dim..(i + 1) * dim];
@@ -721,6 +724,9 @@ fn correct_state<S: Stepper>(
     stepper: &mut S,
     corrected: &mut [f64],
 ) -> Result<bool, StepFailure> {
+    if !rhs.corrects_state() {
+        return Ok(false);
+    }
     let t = stepper.t();
     corrected.copy_from_slice(stepper.y());
     if rhs.after_step(t, corrected)? {

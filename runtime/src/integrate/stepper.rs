@@ -177,6 +177,8 @@ pub(crate) fn first_non_finite(values: &[f64]) -> Option<usize> {
 /// system has none) and factorisations of iteration matrices counted as well.
 pub(crate) struct CheckedRhs<'a> {
     system: &'a mut dyn OdeSystem,
+    /// [`OdeSystem::corrects_state`], asked once.
+    corrects_state: bool,
     evals: usize,
     jacobian_evals: usize,
     lu_decompositions: usize,
@@ -188,6 +190,7 @@ impl<'a> CheckedRhs<'a> {
     /// Wraps `system`, with nothing counted yet.
     pub(crate) fn new(system: &'a mut dyn OdeSystem) -> Self {
         Self {
+            corrects_state: system.corrects_state(),
             system,
             evals: 0,
             jacobian_evals: 0,
@@ -279,6 +282,13 @@ impl<'a> CheckedRhs<'a> {
     /// the real and the complex one together count once, as in Hairer's RADAU5).
     pub(crate) fn count_lu(&mut self) {
         self.lu_decompositions += 1;
+    }
+
+    /// Whether the system's correction after a step can change a state
+    /// ([`OdeSystem::corrects_state`]): if not, the driver neither copies the state nor calls
+    /// [`Self::after_step`].
+    pub(crate) fn corrects_state(&self) -> bool {
+        self.corrects_state
     }
 
     /// The system's correction after an accepted step ([`OdeSystem::after_step`]), applied
