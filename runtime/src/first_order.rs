@@ -182,7 +182,7 @@ impl<S: MechanicalSystem<N>, const N: usize> OdeSystem for FirstOrder<S, N> {
     }
 
     fn after_step(&mut self, t: f64, y: &mut [f64]) -> Result<bool, RhsError> {
-        if self.constraints.is_empty() || self.stabilization != Stabilization::Projection {
+        if !self.corrects_state() {
             return Ok(false);
         }
         let (q, qdot) = y.split_at_mut(N);
@@ -574,7 +574,7 @@ impl<S: DynMechanicalSystem> OdeSystem for DynFirstOrder<S> {
     }
 
     fn after_step(&mut self, t: f64, y: &mut [f64]) -> Result<bool, RhsError> {
-        if self.constraints.is_empty() || self.stabilization != Stabilization::Projection {
+        if !self.corrects_state() {
             return Ok(false);
         }
         let n = self.n;

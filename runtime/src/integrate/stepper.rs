@@ -149,28 +149,7 @@ impl AttemptTimes {
     }
 }
 
-/// Index of the first entry of `values` that is NaN or infinite, if any.
-///
-/// The common case (all finite) takes one branch: `0 · x` is ±0 for a finite `x` and NaN for
-/// ±∞ or NaN, so the sum of those products (in four independent partial sums) is 0 exactly
-/// when every entry is finite; otherwise the entry is searched for.
-#[inline]
-pub(crate) fn first_non_finite(values: &[f64]) -> Option<usize> {
-    let chunks = values.chunks_exact(4);
-    let mut total = chunks.remainder().iter().fold(0.0, |s, &x| s + 0.0 * x);
-    let mut partial = [0.0f64; 4];
-    for chunk in chunks {
-        for (p, &x) in partial.iter_mut().zip(chunk) {
-            *p += 0.0 * x;
-        }
-    }
-    total += (partial[0] + partial[1]) + (partial[2] + partial[3]);
-    if total == 0.0 {
-        None
-    } else {
-        values.iter().position(|v| !v.is_finite())
-    }
-}
+pub(crate) use crate::ode::first_non_finite;
 
 /// The system as a stepper sees it: every evaluation of `F` counted and checked for
 /// finiteness, so that no method can forget either; Jacobians (exact, or differenced when the
@@ -526,24 +505,6 @@ mod tests {
     use crate::integrate::explicit_rk::ExplicitRk;
     use crate::integrate::tableau::Tableau;
     use crate::ode::OdeFn;
-
-    #[test]
-    fn first_non_finite_finds_the_first_nan_or_infinity_in_any_position() {
-        for len in 0..11 {
-            let finite: Vec<f64> = (0..len).map(|i| i as f64 * 1e300 - 3e300).collect();
-            assert_eq!(first_non_finite(&finite), None, "{finite:?}");
-            for at in 0..len {
-                for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
-                    let mut v = finite.clone();
-                    v[at] = bad;
-                    if at + 1 < len {
-                        v[len - 1] = f64::NAN;
-                    }
-                    assert_eq!(first_non_finite(&v), Some(at), "{v:?}");
-                }
-            }
-        }
-    }
 
     /// `ẏ = 1` in `.0` components, except that `F` is NaN for `t` in `(0.065, 0.066)`, and
     /// that it refuses a NaN state as a model with a singular mass matrix there would.

@@ -8,7 +8,7 @@ use super::driver::{self, Control, Problem};
 use super::error::{IntegrationError, IntegrationFailure};
 use super::options::{ErrorWeights, IntegratorOptions, Tolerance};
 use super::solution::Solution;
-use super::stepper::{CheckedRhs, StepFailure, Stepper, SystemShape};
+use super::stepper::{CheckedRhs, StepFailure, Stepper, SystemShape, first_non_finite};
 use crate::ode::OdeSystem;
 
 /// `$sized` with `$d` a constant, for the state's usual sizes (2, 4, 6, 8 and 12 values:
@@ -574,7 +574,7 @@ impl Stepper for TaylorStepper {
             &mut self.y_new,
             Some(&mut self.carry_new),
         );
-        match self.y_new.iter().position(|v| !v.is_finite()) {
+        match first_non_finite(&self.y_new) {
             Some(index) => Err(StepFailure::NonFiniteState { t: t_new, index }),
             None => Ok(None),
         }

@@ -445,33 +445,11 @@ fn series_in(
 }
 
 /// `Ok` when every coefficient in `out` is finite, else the component (of `dim`) of the first
-/// that is not. In line: part of the hot step, in its copy for the host's instruction set.
+/// that is not ([`first_non_finite`](crate::ode::first_non_finite), in line: part of the hot
+/// step, in its copy for the host's instruction set).
 #[inline(always)]
 fn all_finite(out: &[f64], dim: usize) -> Result<(), RhsError> {
-    // A value's exponent field alone (sign and mantissa cleared), read as an `f64`, is +0, a
-    // power of two, or +∞, the last exactly when the value is infinite or NaN (of either
-    // sign); so the largest of them is +∞ exactly when one value is not finite. Four lanes of independent maxima, an AND and a MAX for four values
-    // (the OR of a test per value that this replaces took 82 instructions for the double
-    // pendulum's 28 coefficients at 10⁻⁴; a branch per value, 3 % of a step, before that).
-    const EXPONENT: u64 = 0x7ff0_0000_0000_0000;
-    let field = |v: f64| f64::from_bits(v.to_bits() & EXPONENT);
-    let (chunks, rest) = out.as_chunks::<4>();
-    let mut largest = [0.0f64; 4];
-    for chunk in chunks {
-        for (m, &v) in largest.iter_mut().zip(chunk) {
-            let e = field(v);
-            *m = if e > *m { e } else { *m };
-        }
-    }
-    for (m, &v) in largest.iter_mut().zip(rest) {
-        let e = field(v);
-        *m = if e > *m { e } else { *m };
-    }
-    let finite = largest.iter().all(|&m| m < f64::INFINITY);
-    match (!finite)
-        .then(|| out.iter().position(|v| !v.is_finite()))
-        .flatten()
-    {
+    match crate::ode::first_non_finite(out) {
         Some(at) => Err(RhsError::NonFinite { index: at % dim }),
         None => Ok(()),
     }
