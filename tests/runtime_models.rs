@@ -308,24 +308,28 @@ fn run_time_descriptions_carry_mathml_on_request_and_the_files_references_always
 /// The fused right-hand side of a run-time model (`DynMechanicalSystem::first_order_rhs`: the
 /// equations and the solve compiled as one function, for unconstrained models of one to four
 /// degrees of freedom) equals `mass_matrix_and_forcing` followed by `solve_spd_in_place` to
-/// the bit, and its pivots are positive exactly where that solve finds `M` positive definite.
-/// Every bundled model of those sizes, at 20 random states with the file's parameters and 20
-/// with random parameters of either sign, which make many mass matrices indefinite or NaN
-/// (the failure paths). Larger and constrained models have no fused right-hand side.
+/// the bit where that solve finds `M` positive definite, and its verdict is sound exactly where
+/// the solve succeeds with a finite `q̈`. `DynFirstOrder::rhs`, which takes the fused form
+/// where its verdict is sound and computes again otherwise, returns that solve's result or its
+/// error (`SingularMassMatrix`, or `NonFinite` at the first `q̈` not finite). Every bundled
+/// model of those sizes, at 20 random states with the file's parameters and 20 with random
+/// parameters of either sign, which make many mass matrices indefinite or NaN (the failure
+/// paths). Larger and constrained models have no fused right-hand side.
 #[test]
 fn the_fused_right_hand_side_is_the_equations_then_the_solve_to_the_bit() {
-    use eomgen::DynMechanicalSystem;
+    use eomgen::{DynFirstOrder, DynMechanicalSystem, OdeSystem, RhsError};
     let mut random = seeded_rng(7);
     let mut fused_sizes = [0usize; 5];
-    let mut refused = 0;
+    let (mut refused, mut sound) = (0, 0);
     for entry in eomgen::models::ALL {
-        let mut model = JitModel::load(bundled_file(entry)).unwrap();
+        let mut first_order = DynFirstOrder::new(JitModel::load(bundled_file(entry)).unwrap());
+        let model = &mut first_order.system;
         let n = model.num_dofs();
         let unconstrained = model.description().constraints.is_empty();
-        let (mut y, mut dy, mut pivots) = (vec![0.0; 2 * n], vec![0.0; 2 * n], vec![0.0; n]);
-        let fused = model.first_order_rhs(0.0, &y, &mut dy, &mut pivots);
+        let (mut y, mut dy) = (vec![0.0; 2 * n], vec![0.0; 2 * n]);
+        let fused = model.first_order_rhs(0.0, &y, &mut dy).is_some();
         assert_eq!(fused, unconstrained && n <= 4, "{}: fused", entry.name);
-        if !fused {
+        if !fused || model.description().has_speeds() {
             continue;
         }
         fused_sizes[n] += 1;
@@ -338,6 +342,7 @@ fn the_fused_right_hand_side_is_the_equations_then_the_solve_to_the_bit() {
         let (mut mass, mut work, mut envelope) =
             (vec![0.0; n * n], vec![0.0; n * n + 2 * n], vec![0; 2 * n]);
         for state in 0..40 {
+            let model = &mut first_order.system;
             if state == 20 {
                 for name in &names {
                     model
@@ -349,7 +354,7 @@ fn the_fused_right_hand_side_is_the_equations_then_the_solve_to_the_bit() {
                 *v = random.random_range(-3.0..3.0);
             }
             let t = random.random_range(0.0..5.0);
-            assert!(model.first_order_rhs(t, &y, &mut dy, &mut pivots));
+            let verdict = model.first_order_rhs(t, &y, &mut dy).unwrap();
             let mut forcing = vec![0.0; n];
             model.mass_matrix_and_forcing(&y[..n], &y[n..], t, &mut mass, &mut forcing);
             let solved = eomgen::linalg::solve_spd_in_place(
@@ -360,16 +365,24 @@ fn the_fused_right_hand_side_is_the_equations_then_the_solve_to_the_bit() {
                 &mut envelope,
             );
             let at = format!("{} at state {state}: {y:?}", entry.name);
-            assert_eq!(
-                solved.is_some(),
-                pivots.iter().all(|&d| d > 0.0),
-                "{at}: positive definite? pivots {pivots:?}, M {mass:?}"
-            );
+            let expected = match forcing.iter().position(|v| !v.is_finite()) {
+                _ if solved.is_none() => Err(RhsError::SingularMassMatrix),
+                Some(i) => Err(RhsError::NonFinite { index: n + i }),
+                None => Ok(()),
+            };
+            assert_eq!(verdict, expected.is_ok(), "{at}: verdict, M {mass:?}");
             if solved.is_some() {
                 assert_same(&format!("{at}: qdot"), &dy[..n], &y[n..]);
                 assert_same(&format!("{at}: qddot"), &dy[n..], &forcing);
             } else {
                 refused += 1;
+            }
+            sound += usize::from(verdict);
+            let mut through = vec![f64::NAN; 2 * n];
+            let result = first_order.rhs(t, &y, &mut through);
+            assert_eq!(result, expected, "{at}: DynFirstOrder::rhs");
+            if result.is_ok() {
+                assert_same(&format!("{at}: DynFirstOrder::rhs"), &through, &dy);
             }
         }
     }
@@ -378,4 +391,5 @@ fn the_fused_right_hand_side_is_the_equations_then_the_solve_to_the_bit() {
         "every fused size is tested: {fused_sizes:?}"
     );
     assert!(refused > 0, "no mass matrix was indefinite");
+    assert!(sound > 0, "no verdict was sound");
 }

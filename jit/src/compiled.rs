@@ -198,8 +198,7 @@ pub(crate) unsafe fn with_scratch(
     });
 }
 
-/// A compiled fused right-hand side whose call needs only the lengths of `y`, `ẏ` and the
-/// pivots checked (its tape reads `q` and `q̇` of a model of `n` degrees of freedom, at most
+/// A compiled fused right-hand side whose call needs only the lengths of `y` and `ẏ` checked (its tape reads `q` and `q̇` of a model of `n` degrees of freedom, at most
 /// the model's parameters, no accelerations or multipliers).
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct FusedRhs {
@@ -220,8 +219,7 @@ impl FusedRhs {
             && extent.qdot <= n
             && extent.acceleration == 0
             && extent.lambda == 0
-            && extent.out0 == 2 * n
-            && extent.out1 == n;
+            && extent.out0 == 2 * n;
         simple.then_some(FusedRhs { f, n })
     }
 }

@@ -15,10 +15,15 @@
 //! factorisation's code grows as `n³`, and their equations dominate the cost anyway).
 //!
 //! # Outputs
-//! The first buffer gets `ẏ` (`2n` values: `q̇`, then `q̈`), the second the `n` values whose
+//! The tape's outputs are `ẏ` (`2n` values: `q̇`, then `q̈`), then the `n` values whose
 //! positivity is Sylvester's criterion, as `solve_spd` tests it: `M₀₀` and `det M` for
-//! `n = 2`, the pivots `dⱼ` of `D` otherwise. The caller judges them (a pivot that is not
-//! positive, or NaN, means `M` is not positive definite and `q̈` is meaningless).
+//! `n = 2`, the pivots `dⱼ` of `D` otherwise. The native function stores `ẏ` and returns its
+//! verdict on the others: 1 if every pivot is positive (a NaN is not) and every `q̈` finite,
+//! else 0 (`M` not positive definite and `q̈` meaningless, or a `q̈` not finite). Judged in
+//! the function, on values still in registers, the verdict costs the caller one test: on two
+//! masses the right-hand side went from 135 to 103 instructions a call and from 1.25× to
+//! 1.04–1.06× the time of `model!`'s (`benches/runtime_model.rs`), against reading the pivots
+//! and `q̈` back from memory.
 
 use eomgen_symbolic::codegen::program::FunctionTape;
 use eomgen_symbolic::codegen::tape::{Input, Instruction, Tape, Value};

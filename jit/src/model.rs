@@ -556,26 +556,16 @@ impl DynMechanicalSystem for JitModel {
         }
     }
     #[inline(always)]
-    fn first_order_rhs(&self, t: f64, y: &[f64], dy: &mut [f64], pivots: &mut [f64]) -> bool {
-        let Some(FusedRhs { f, n }) = self.first_order else {
-            return false;
-        };
-        if y.len() < 2 * n || dy.len() < 2 * n || pivots.len() < n {
-            return false;
+    fn first_order_rhs(&self, t: f64, y: &[f64], dy: &mut [f64]) -> Option<bool> {
+        let FusedRhs { f, n } = self.first_order?;
+        if y.len() < 2 * n || dy.len() < 2 * n {
+            return None;
         }
         // SAFETY: `f` is the native code of the fused tape (`first_order_tape`); it reads at
-        // most `2n` values of `y` and the model's parameters, writes `2n` values to `dy` and
-        // `n` to `pivots` (`FusedRhs::new`; the lengths are checked above).
-        unsafe {
-            f(
-                self.parameters.as_ptr(),
-                y.as_ptr(),
-                t,
-                dy.as_mut_ptr(),
-                pivots.as_mut_ptr(),
-            )
-        };
-        true
+        // most `2n` values of `y` and the model's parameters and writes `2n` values to `dy`
+        // (`FusedRhs::new`; the lengths are checked above).
+        let verdict = unsafe { f(self.parameters.as_ptr(), y.as_ptr(), t, dy.as_mut_ptr()) };
+        Some(verdict != 0)
     }
     fn forcing_jacobian_q(&self, q: &[f64], qdot: &[f64], t: f64, out: &mut [f64]) {
         self.run(

@@ -67,20 +67,20 @@ pub(crate) type NativeFn = unsafe extern "C" fn(
 );
 
 /// A compiled right-hand side `ẏ = [q̇; M⁻¹F]` ([`crate::first_order`]): `(parameters, y, t,
-/// ẏ, pivots)`, with `q` the first `n` values of `y` and `q̇` the next `n`.
+/// ẏ)`, with `q` the first `n` values of `y` and `q̇` the next `n`; returns its verdict, 1 if
+/// `M` is positive definite and `q̈` finite, else 0.
 ///
 /// # Safety
-/// As [`NativeFn`]: `y` and `ẏ` hold `2n` values, `pivots` `n`.
-pub(crate) type FirstOrderFn =
-    unsafe extern "C" fn(*const f64, *const f64, f64, *mut f64, *mut f64);
+/// As [`NativeFn`]: `y` and `ẏ` hold `2n` values.
+pub(crate) type FirstOrderFn = unsafe extern "C" fn(*const f64, *const f64, f64, *mut f64) -> u8;
 
 /// The arguments a compiled function takes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Layout {
     /// [`NativeFn`]'s nine.
     Model,
-    /// [`FirstOrderFn`]'s five, for a model of `n` degrees of freedom: no accelerations,
-    /// multipliers or scratch space, and four arguments fewer to pass (the right-hand side is
+    /// [`FirstOrderFn`]'s four, for a model of `n` degrees of freedom: no accelerations,
+    /// multipliers or scratch space, and five arguments fewer to pass (the right-hand side is
     /// called millions of times, and on a model of one or two degrees of freedom the call is a
     /// good part of it).
     FirstOrder { n: usize },
@@ -229,12 +229,15 @@ fn tape_signature(call_conv: CallConv, pointer: ir::Type, layout: Layout) -> Sig
     let mut signature = Signature::new(call_conv);
     let (before, after) = match layout {
         Layout::Model => (5, 3),
-        Layout::FirstOrder { .. } => (2, 2),
+        Layout::FirstOrder { .. } => (2, 1),
     };
     let pointers = |k: usize| (0..k).map(|_| AbiParam::new(pointer));
     signature.params.extend(pointers(before));
     signature.params.push(AbiParam::new(types::F64));
     signature.params.extend(pointers(after));
+    if let Layout::FirstOrder { .. } = layout {
+        signature.returns.push(AbiParam::new(types::I8));
+    }
     signature
 }
 
@@ -369,7 +372,7 @@ fn build(
                 t: params[2],
             },
             params[3],
-            params[4],
+            params[3],
             None,
         ),
     };
@@ -380,7 +383,11 @@ fn build(
         split: function.split.min(tape.outputs.len()),
     };
     let count = tape.instructions.len();
-    let filled = fill_zero_runs(&mut b, module, imports, tape, &outputs);
+    let mut filled = fill_zero_runs(&mut b, module, imports, tape, &outputs);
+    // A first-order function stores `ẏ` only; its pivots go into the verdict it returns.
+    if let Layout::FirstOrder { n } = layout {
+        filled[2 * n..].fill(true);
+    }
     let (scratch, slots_used) = match scratch_buffer {
         Some(buffer) if count > SCRATCH_FROM_INSTRUCTIONS => {
             let (slots, used) = scratch_slots(tape);
@@ -419,8 +426,12 @@ fn build(
     } else {
         emitter.store_output_pairs(&filled);
     }
+    let verdict = match layout {
+        Layout::FirstOrder { n } => vec![emitter.verdict(n)],
+        Layout::Model => Vec::new(),
+    };
     let Emitter { mut b, module, .. } = emitter;
-    b.ins().return_(&[]);
+    b.ins().return_(&verdict);
     b.finalize(module.target_config());
     slots_used
 }
@@ -719,6 +730,49 @@ impl Emitter<'_, '_> {
         };
         self.values.values[k] = Some(value);
         self.spill(k, value);
+    }
+
+    /// A first-order function's verdict: 1 if every pivot (outputs `2n..3n`) is positive and
+    /// every `q̈` (outputs `n..2n`) finite, else 0 (a NaN fails both). Tested two at a time
+    /// (an odd `n`'s last value beside itself): on two bodies (`n = 4`) one test at a time
+    /// took 38 instructions and made the right-hand side 1.06× `model!`'s, against 0.69–0.71×
+    /// with the tests in the caller.
+    fn verdict(&mut self, n: usize) -> ir::Value {
+        let outputs = &self.tape.outputs;
+        let zero = self.b.ins().f64const(0.0);
+        let zero = self.b.ins().splat(types::F64X2, zero);
+        let infinity = self.b.ins().f64const(f64::INFINITY);
+        let infinity = self.b.ins().splat(types::F64X2, infinity);
+        let mut all: Option<ir::Value> = None;
+        for i in (0..n).step_by(2) {
+            let j = (i + 1).min(n - 1);
+            let pivots = self.pair(outputs[2 * n + i], outputs[2 * n + j]);
+            let qdd = self.pair(outputs[n + i], outputs[n + j]);
+            let positive = self.b.ins().fcmp(FloatCC::GreaterThan, pivots, zero);
+            let magnitude = self.b.ins().fabs(qdd);
+            let finite = self.b.ins().fcmp(FloatCC::LessThan, magnitude, infinity);
+            let both = self.b.ins().band(positive, finite);
+            all = Some(match all {
+                Some(all) => self.b.ins().band(all, both),
+                None => both,
+            });
+        }
+        match all {
+            Some(all) => self.b.ins().vall_true(all),
+            None => self.b.ins().iconst(types::I8, 1),
+        }
+    }
+
+    /// Tape values `first` and `second` as the lanes of one `f64x2`, built as
+    /// [`Emitter::store_output_pairs`] builds a pair (so that the same pair is built once).
+    fn pair(&mut self, first: u32, second: u32) -> ir::Value {
+        let first_value = self.value(first);
+        let vector = self.b.ins().splat(types::F64X2, first_value);
+        if second == first {
+            return vector;
+        }
+        let second = self.value(second);
+        self.b.ins().insertlane(vector, second, 1)
     }
 
     /// In a large function, stores the outputs that are inputs: computed outputs and

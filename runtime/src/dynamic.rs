@@ -61,18 +61,20 @@ pub trait DynMechanicalSystem {
     /// The first-order right-hand side `ẏ = [q̇; M⁻¹F]` of a model without constraints in one
     /// call, where the model has it as one function (a run-time model of up to four degrees of
     /// freedom: the equations and the solve compiled together, `eomgen_jit`'s `first_order`
-    /// module); `false`, writing nothing, where it has not.
+    /// module), with its verdict: `Some(true)` where `M` is positive definite, as
+    /// [`crate::linalg::solve_spd`] tests it (`M₀₀` and `det M` for `n = 2`, the pivots of
+    /// `M = L D Lᵀ` otherwise, each positive and not NaN), and every `q̈` is finite;
+    /// `Some(false)` otherwise; `None`, writing nothing, where the model has no such function.
+    /// The model's kinematic equations are not applied: `q̇` is copied from `y`.
     ///
     /// # Shapes
-    /// `y = [q; q̇]` and `dy` of length `2n`; `pivots` of length `n` receives the values
-    /// whose positivity makes `M` positive definite, as [`crate::linalg::solve_spd`] tests it
-    /// (`M₀₀` and `det M` for `n = 2`, the pivots of `M = L D Lᵀ` otherwise). `dy` is
-    /// [`crate::linalg::solve_spd`]'s `q̈` to the bit where they all are positive, and
-    /// meaningless otherwise: the caller judges them (`DynFirstOrder` reports
-    /// [`crate::RhsError::SingularMassMatrix`]).
-    fn first_order_rhs(&self, t: f64, y: &[f64], dy: &mut [f64], pivots: &mut [f64]) -> bool {
-        let _ = (t, y, dy, pivots);
-        false
+    /// `y = [q; q̇]` and `dy` of length `2n`. `dy`'s `q̈` is [`crate::linalg::solve_spd`]'s to
+    /// the bit where `M` is positive definite, and meaningless otherwise. The verdict says
+    /// only whether both tests pass: `DynFirstOrder` computes a failing case again, by
+    /// `M` and `F` and the solve, for the error it reports.
+    fn first_order_rhs(&self, t: f64, y: &[f64], dy: &mut [f64]) -> Option<bool> {
+        let _ = (t, y, dy);
+        None
     }
     /// Exact `∂F/∂q` (`n × n`, column-major; entry `(i, j)` is `∂Fᵢ/∂qⱼ`) into `out`.
     fn forcing_jacobian_q(&self, q: &[f64], qdot: &[f64], t: f64, out: &mut [f64]);

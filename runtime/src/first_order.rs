@@ -454,26 +454,42 @@ impl<S: DynMechanicalSystem> DynFirstOrder<S> {
 }
 
 impl<S: DynMechanicalSystem> DynFirstOrder<S> {
+    /// Every right-hand side but a sound fused one: in speeds, constrained, of a system
+    /// without the fused form, or where the fused form's verdict failed (computed again by
+    /// `M` and `F`, then the solve, to the same bits, for the error it reports).
+    #[inline(never)]
+    fn rhs_unfused(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), RhsError> {
+        if self.speeds {
+            return self.rhs_in_speeds(t, y, dy);
+        }
+        if self.constraints.is_empty() {
+            // The sizes of most mechanisms, with the matrices on the stack and the solve of
+            // `FirstOrder` (the same operations as `solve_spd_in_place`): on the double
+            // pendulum this path is ~6 ns shorter than the general one (`benches/runtime_model.rs`).
+            match self.n {
+                1 => return self.unconstrained_rhs::<1>(t, y, dy),
+                2 => return self.unconstrained_rhs::<2>(t, y, dy),
+                3 => return self.unconstrained_rhs::<3>(t, y, dy),
+                4 => return self.unconstrained_rhs::<4>(t, y, dy),
+                _ => {}
+            }
+        }
+        let n = self.n;
+        let (q, qdot) = (&y[..n], &y[n..2 * n]);
+        let (velocity, acceleration) = dy.split_at_mut(n);
+        self.generalized_accelerations(q, qdot, t, acceleration)?;
+        velocity.copy_from_slice(qdot);
+        Ok(())
+    }
+
     /// The right-hand side of an unconstrained system of `N = n` degrees of freedom, as
-    /// `FirstOrder::rhs` computes it: in one call where the system has it fused
-    /// ([`DynMechanicalSystem::first_order_rhs`]), else `M` and `F`, then the solve.
+    /// `FirstOrder::rhs` computes it: `M` and `F`, then the solve.
     fn unconstrained_rhs<const N: usize>(
         &mut self,
         t: f64,
         y: &[f64],
         dy: &mut [f64],
     ) -> Result<(), RhsError> {
-        let mut pivots = [0.0; N];
-        if self.system.first_order_rhs(t, y, dy, &mut pivots) {
-            // Not positive, or NaN.
-            if !pivots.iter().all(|&d| d > 0.0) {
-                return Err(RhsError::SingularMassMatrix);
-            }
-            return match dy[N..2 * N].iter().position(|v| !v.is_finite()) {
-                Some(i) => Err(RhsError::NonFinite { index: N + i }),
-                None => Ok(()),
-            };
-        }
         let mut mass = SMatrix::<f64, N, N>::zeros();
         let mut forcing = SVector::<f64, N>::zeros();
         self.system.mass_matrix_and_forcing(
@@ -544,28 +560,19 @@ impl<S: DynMechanicalSystem> OdeSystem for DynFirstOrder<S> {
         2 * self.n
     }
 
+    /// The fused form where the system has it ([`DynMechanicalSystem::first_order_rhs`]) and
+    /// its verdict is sound; otherwise every other form, out of line, so that the fused call's
+    /// frame is small (with every form in one function it saved six registers and reserved
+    /// 200 bytes of stack a call).
+    #[inline]
     fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), RhsError> {
-        if self.speeds {
-            return self.rhs_in_speeds(t, y, dy);
+        if !self.speeds
+            && self.constraints.is_empty()
+            && self.system.first_order_rhs(t, y, dy) == Some(true)
+        {
+            return Ok(());
         }
-        if self.constraints.is_empty() {
-            // The sizes of most mechanisms, with the matrices on the stack and the solve of
-            // `FirstOrder` (the same operations as `solve_spd_in_place`): on the double
-            // pendulum this path is ~6 ns shorter than the general one (`benches/runtime_model.rs`).
-            match self.n {
-                1 => return self.unconstrained_rhs::<1>(t, y, dy),
-                2 => return self.unconstrained_rhs::<2>(t, y, dy),
-                3 => return self.unconstrained_rhs::<3>(t, y, dy),
-                4 => return self.unconstrained_rhs::<4>(t, y, dy),
-                _ => {}
-            }
-        }
-        let n = self.n;
-        let (q, qdot) = (&y[..n], &y[n..2 * n]);
-        let (velocity, acceleration) = dy.split_at_mut(n);
-        self.generalized_accelerations(q, qdot, t, acceleration)?;
-        velocity.copy_from_slice(qdot);
-        Ok(())
+        self.rhs_unfused(t, y, dy)
     }
 
     /// Only a constrained model projected after each step ([`Stabilization::Projection`]).
