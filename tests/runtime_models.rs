@@ -312,24 +312,26 @@ fn run_time_descriptions_carry_mathml_on_request_and_the_files_references_always
 /// the solve succeeds with a finite `q̈`. `DynFirstOrder::rhs`, which takes the fused form
 /// where its verdict is sound and computes again otherwise, returns that solve's result or its
 /// error (`SingularMassMatrix`, or `NonFinite` at the first `q̈` not finite). Every bundled
-/// model of those sizes, at 20 random states with the file's parameters and 20 with random
-/// parameters of either sign, which make many mass matrices indefinite or NaN (the failure
-/// paths). Larger and constrained models have no fused right-hand side.
+/// unconstrained model of those sizes, at 20 random states with the file's parameters, 20 with
+/// random parameters of either sign, which make many mass matrices indefinite or NaN, and 2
+/// with rates of ±1e200, whose squares overflow (the failure paths). Larger and constrained
+/// models have no fused right-hand side.
 #[test]
 fn the_fused_right_hand_side_is_the_equations_then_the_solve_to_the_bit() {
     use eomgen::{DynFirstOrder, DynMechanicalSystem, OdeSystem, RhsError};
     let mut random = seeded_rng(7);
     let mut fused_sizes = [0usize; 5];
-    let (mut refused, mut sound) = (0, 0);
+    let (mut refused, mut sound, mut overflowed) = (0, 0, 0);
     for entry in eomgen::models::ALL {
         let mut first_order = DynFirstOrder::new(JitModel::load(bundled_file(entry)).unwrap());
         let model = &mut first_order.system;
         let n = model.num_dofs();
-        let unconstrained = model.description().constraints.is_empty();
+        let unconstrained =
+            model.description().constraints.is_empty() && !model.description().has_speeds();
         let (mut y, mut dy) = (vec![0.0; 2 * n], vec![0.0; 2 * n]);
         let fused = model.first_order_rhs(0.0, &y, &mut dy).is_some();
         assert_eq!(fused, unconstrained && n <= 4, "{}: fused", entry.name);
-        if !fused || model.description().has_speeds() {
+        if !fused {
             continue;
         }
         fused_sizes[n] += 1;
@@ -341,7 +343,7 @@ fn the_fused_right_hand_side_is_the_equations_then_the_solve_to_the_bit() {
             .collect();
         let (mut mass, mut work, mut envelope) =
             (vec![0.0; n * n], vec![0.0; n * n + 2 * n], vec![0; 2 * n]);
-        for state in 0..40 {
+        for state in 0..42 {
             let model = &mut first_order.system;
             if state == 20 {
                 for name in &names {
@@ -352,6 +354,11 @@ fn the_fused_right_hand_side_is_the_equations_then_the_solve_to_the_bit() {
             }
             for v in &mut y {
                 *v = random.random_range(-3.0..3.0);
+            }
+            if state >= 40 {
+                for v in &mut y[n..] {
+                    *v = if state == 40 { 1e200 } else { -1e200 };
+                }
             }
             let t = random.random_range(0.0..5.0);
             let verdict = model.first_order_rhs(t, &y, &mut dy).unwrap();
@@ -378,6 +385,7 @@ fn the_fused_right_hand_side_is_the_equations_then_the_solve_to_the_bit() {
                 refused += 1;
             }
             sound += usize::from(verdict);
+            overflowed += usize::from(matches!(expected, Err(RhsError::NonFinite { .. })));
             let mut through = vec![f64::NAN; 2 * n];
             let result = first_order.rhs(t, &y, &mut through);
             assert_eq!(result, expected, "{at}: DynFirstOrder::rhs");
@@ -392,4 +400,5 @@ fn the_fused_right_hand_side_is_the_equations_then_the_solve_to_the_bit() {
     );
     assert!(refused > 0, "no mass matrix was indefinite");
     assert!(sound > 0, "no verdict was sound");
+    assert!(overflowed > 0, "no q̈ overflowed");
 }

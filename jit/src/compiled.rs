@@ -198,8 +198,9 @@ pub(crate) unsafe fn with_scratch(
     });
 }
 
-/// A compiled fused right-hand side whose call needs only the lengths of `y` and `ẏ` checked (its tape reads `q` and `q̇` of a model of `n` degrees of freedom, at most
-/// the model's parameters, no accelerations or multipliers).
+/// A compiled fused right-hand side whose call needs only the lengths of `y` and `ẏ` checked
+/// (its tape reads `q` and `q̇` of a model of `n` degrees of freedom, at most the model's
+/// parameters, no accelerations or multipliers).
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct FusedRhs {
     pub(crate) f: FirstOrderFn,

@@ -318,9 +318,10 @@ impl JitModel {
         options: LoadOptions,
     ) -> Result<JitModel, LoadError> {
         // The fused right-hand side, compiled with the model's own functions where they are
-        // compiled.
+        // compiled; not in generalized speeds, whose rates are not `q̇ = u`.
         let n = program.num_dofs();
         let fused = (program.description.constraints.is_empty()
+            && !program.description.has_speeds()
             && options.backend != Some(Backend::Interpreter))
         .then(|| first_order_tape(&program.mass_matrix_and_forcing, n))
         .flatten();

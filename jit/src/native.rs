@@ -46,8 +46,10 @@ use eomgen_symbolic::codegen::tape::{Input, Instruction};
 use eomgen_symbolic::expr::Func;
 
 mod module;
+mod outputs;
 pub use module::CompileError;
 pub(crate) use module::{CodeLayout, Imports, ModuleMemory, declare_imports, failure, new_module};
+use outputs::{OutputBuffers, ZERO_RUN, fill_zero_runs, output_destinations, scratch_slots};
 
 /// A compiled function: see the module documentation for its arguments.
 ///
@@ -89,10 +91,6 @@ enum Layout {
 /// Functions of more instructions than this keep their shared values in a scratch buffer
 /// instead of registers (see [`build`]).
 const SCRATCH_FROM_INSTRUCTIONS: usize = 1500;
-
-/// Runs of at least this many consecutive outputs that are the constant `+0.0` are written by
-/// one call of [`crate::math::fill_zero`] (see [`zero_runs`]).
-const ZERO_RUN: usize = 16;
 
 /// The native code of a model's functions and the memory that holds it.
 pub(crate) struct NativeCode {
@@ -236,7 +234,8 @@ fn tape_signature(call_conv: CallConv, pointer: ir::Type, layout: Layout) -> Sig
     signature.params.push(AbiParam::new(types::F64));
     signature.params.extend(pointers(after));
     if let Layout::FirstOrder { .. } = layout {
-        signature.returns.push(AbiParam::new(types::I8));
+        // Extended to 32 bits where the platform's C convention extends a `u8` result.
+        signature.returns.push(AbiParam::new(types::I8).uext());
     }
     signature
 }
@@ -333,7 +332,8 @@ impl Values {
 /// and of the imported functions' references is part of the generated code): the calls that
 /// zero long runs of outputs ([`fill_zero_runs`]), the tape's instructions one by one
 /// ([`Emitter::instruction`]), then the outputs not stored yet ([`Emitter::store_inputs`] in
-/// a large function, [`Emitter::store_output_pairs`] otherwise).
+/// a large function, [`Emitter::store_output_pairs`] otherwise); a first-order function then
+/// returns its verdict ([`Emitter::verdict`]) on the outputs it does not store, its pivots.
 fn build(
     module: &mut JITModule,
     func: &mut ir::Function,
@@ -383,9 +383,12 @@ fn build(
         split: function.split.min(tape.outputs.len()),
     };
     let count = tape.instructions.len();
+    // A first-order function stores `ẏ` only (no run of zeros: it has at most `3n` outputs,
+    // below `ZERO_RUN`); its pivots go into the verdict it returns.
+    const _: () = assert!(3 * crate::first_order::FUSED_UP_TO < ZERO_RUN);
     let mut filled = fill_zero_runs(&mut b, module, imports, tape, &outputs);
-    // A first-order function stores `ẏ` only; its pivots go into the verdict it returns.
     if let Layout::FirstOrder { n } = layout {
+        debug_assert_eq!(tape.outputs.len(), 3 * n, "ẏ, then n pivots");
         filled[2 * n..].fill(true);
     }
     let (scratch, slots_used) = match scratch_buffer {
@@ -444,97 +447,6 @@ pub(crate) fn enter(b: &mut FunctionBuilder) -> Vec<ir::Value> {
     b.switch_to_block(entry);
     b.seal_block(entry);
     b.block_params(entry).to_vec()
-}
-
-/// The two output buffers of a function: outputs before `split` go to `out0`, the others to
-/// `out1`.
-struct OutputBuffers {
-    out0: ir::Value,
-    out1: ir::Value,
-    split: usize,
-}
-
-impl OutputBuffers {
-    /// The buffer of output `j` and its index in that buffer.
-    fn slot(&self, j: usize) -> (ir::Value, usize) {
-        if j < self.split {
-            (self.out0, j)
-        } else {
-            (self.out1, j - self.split)
-        }
-    }
-}
-
-/// Writes the long runs of zero outputs ([`zero_runs`]) first, one call of
-/// [`crate::math::fill_zero`] each; returns `filled`, where `filled[j]` says output `j` is written.
-fn fill_zero_runs(
-    b: &mut FunctionBuilder,
-    module: &mut JITModule,
-    imports: &Imports,
-    tape: &eomgen_symbolic::codegen::tape::Tape,
-    outputs: &OutputBuffers,
-) -> Vec<bool> {
-    let mut filled = vec![false; tape.outputs.len()];
-    let runs = zero_runs(tape, outputs.split);
-    if !runs.is_empty() {
-        let callee = module.declare_func_in_func(imports.fill_zero, b.func);
-        let pointer = module.target_config().pointer_type();
-        for (start, end) in runs {
-            let (base, slot) = outputs.slot(start);
-            let address = b.ins().iadd_imm_s(base, (slot as i64) * 8);
-            let length = b.ins().iconst(pointer, (end - start) as i64);
-            b.ins().call(callee, &[address, length]);
-            filled[start..end].fill(true);
-        }
-    }
-    filled
-}
-
-/// The scratch slot of each instruction of a large function (a value used more than once, or
-/// a `sin_cos`, that is neither an input nor a constant), and how many slots there are.
-fn scratch_slots(tape: &eomgen_symbolic::codegen::tape::Tape) -> (Vec<Option<u32>>, usize) {
-    let mut uses = vec![0u32; tape.instructions.len()];
-    for instruction in &tape.instructions {
-        for x in operands(instruction) {
-            uses[x as usize] += 1;
-        }
-    }
-    for &x in &tape.outputs {
-        uses[x as usize] += 1;
-    }
-    let mut slots_used = 0u32;
-    let slots: Vec<Option<u32>> = tape
-        .instructions
-        .iter()
-        .zip(&uses)
-        .map(|(instruction, &n)| {
-            let shared = n >= 2 || matches!(instruction, Instruction::SinCos(_));
-            let kept = !matches!(instruction, Instruction::Input(_) | Instruction::Const(_));
-            (shared && kept).then(|| {
-                slots_used += 1;
-                slots_used - 1
-            })
-        })
-        .collect();
-    (slots, slots_used as usize)
-}
-
-/// Per instruction, the (buffer, byte offset) of the outputs it is, leaving out the outputs
-/// a run of zeros writes (`filled`).
-fn output_destinations(
-    tape: &eomgen_symbolic::codegen::tape::Tape,
-    filled: &[bool],
-    outputs: &OutputBuffers,
-) -> Vec<Vec<(ir::Value, i32)>> {
-    let mut destinations = vec![Vec::new(); tape.instructions.len()];
-    for (j, &x) in tape.outputs.iter().enumerate() {
-        if filled[j] {
-            continue;
-        }
-        let (base, slot) = outputs.slot(j);
-        destinations[x as usize].push((base, (slot as i32) * 8));
-    }
-    destinations
 }
 
 /// The imported helpers as references from the function being built, each declared at its
@@ -734,9 +646,9 @@ impl Emitter<'_, '_> {
 
     /// A first-order function's verdict: 1 if every pivot (outputs `2n..3n`) is positive and
     /// every `q̈` (outputs `n..2n`) finite, else 0 (a NaN fails both). Tested two at a time
-    /// (an odd `n`'s last value beside itself): on two bodies (`n = 4`) one test at a time
-    /// took 38 instructions and made the right-hand side 1.06× `model!`'s, against 0.69–0.71×
-    /// with the tests in the caller.
+    /// (an odd `n`'s last value beside itself): for two masses one test at a time took 22
+    /// instructions and 6.96–6.98 ns a right-hand side, two at a time 14 and 6.46–6.50 ns
+    /// (`benches/runtime_model.rs`, docs/performance.md).
     fn verdict(&mut self, n: usize) -> ir::Value {
         let outputs = &self.tape.outputs;
         let zero = self.b.ins().f64const(0.0);
@@ -763,8 +675,8 @@ impl Emitter<'_, '_> {
         }
     }
 
-    /// Tape values `first` and `second` as the lanes of one `f64x2`, built as
-    /// [`Emitter::store_output_pairs`] builds a pair (so that the same pair is built once).
+    /// Tape values `first` and `second` as the lanes of one `f64x2` (`first` in both where
+    /// they are the same value), built as [`Emitter::store_output_pairs`] builds a pair.
     fn pair(&mut self, first: u32, second: u32) -> ir::Value {
         let first_value = self.value(first);
         let vector = self.b.ins().splat(types::F64X2, first_value);
@@ -873,49 +785,6 @@ impl Emitter<'_, '_> {
                 }
             }
         }
-    }
-}
-
-/// The runs `[start, end)` of at least [`ZERO_RUN`] consecutive outputs of one buffer (the
-/// outputs before `split` or those after) that are the constant `+0.0` (a `-0.0` keeps its
-/// own store, its sign bit set).
-fn zero_runs(tape: &eomgen_symbolic::codegen::tape::Tape, split: usize) -> Vec<(usize, usize)> {
-    let zero = |j: usize| matches!(tape.instructions[tape.outputs[j] as usize], Instruction::Const(c) if c.to_bits() == 0);
-    let mut runs = Vec::new();
-    for (from, to) in [(0, split), (split, tape.outputs.len())] {
-        let mut j = from;
-        while j < to {
-            if !zero(j) {
-                j += 1;
-                continue;
-            }
-            let start = j;
-            while j < to && zero(j) {
-                j += 1;
-            }
-            if j - start >= ZERO_RUN {
-                runs.push((start, j));
-            }
-        }
-    }
-    runs
-}
-
-/// The values an instruction reads.
-fn operands(instruction: &Instruction) -> Vec<u32> {
-    match *instruction {
-        Instruction::Input(_) | Instruction::Const(_) | Instruction::CosOfSinCos(_) => Vec::new(),
-        Instruction::Neg(x)
-        | Instruction::Sqrt(x)
-        | Instruction::Abs(x)
-        | Instruction::Call(_, x)
-        | Instruction::SinCos(x) => vec![x],
-        Instruction::Add(x, y)
-        | Instruction::Sub(x, y)
-        | Instruction::Mul(x, y)
-        | Instruction::Div(x, y)
-        | Instruction::Powf(x, y)
-        | Instruction::Atan2(x, y) => vec![x, y],
     }
 }
 
