@@ -21,9 +21,11 @@
 //! verdict on the others: 1 if every pivot is positive (a NaN is not) and every `q̈` finite,
 //! else 0 (`M` not positive definite and `q̈` meaningless, or a `q̈` not finite). Judged in
 //! the function, on values still in registers, the verdict costs the caller one test: on two
-//! masses the right-hand side went from 135 to 103 instructions a call and from 8.15 to
-//! 6.50 ns, 1.18× to 0.95× the time of `model!`'s (`benches/runtime_model.rs`,
-//! docs/performance.md), against reading the pivots and `q̈` back from memory.
+//! masses the right-hand side went from 135 to 103 instructions a call with the values tested
+//! one at a time (6.96–6.98 ns), and from 8.15 to 6.50 ns with them tested two at a time
+//! (14 instructions rather than 22): 1.18× to 0.95× the time of `model!`'s
+//! (`benches/runtime_model.rs`, docs/performance.md), against reading the pivots and `q̈` back
+//! from memory.
 
 use eomgen_symbolic::codegen::program::FunctionTape;
 use eomgen_symbolic::codegen::tape::{Input, Instruction, Tape, Value};

@@ -234,7 +234,7 @@ fn tape_signature(call_conv: CallConv, pointer: ir::Type, layout: Layout) -> Sig
     signature.params.push(AbiParam::new(types::F64));
     signature.params.extend(pointers(after));
     if let Layout::FirstOrder { .. } = layout {
-        // Extended to 32 bits where the platform's C convention extends a `u8` result.
+        // Zero-extended where the calling convention asks for a `u8` result to be.
         signature.returns.push(AbiParam::new(types::I8).uext());
     }
     signature

@@ -59,9 +59,9 @@ pub trait DynMechanicalSystem {
         forcing: &mut [f64],
     );
     /// The first-order right-hand side `ẏ = [q̇; M⁻¹F]` of a model without constraints, in its
-    /// coordinates' rates (not in generalized speeds), in one call, where the model has it as one function (a run-time model of up to four degrees of
-    /// freedom: the equations and the solve compiled together, `eomgen_jit`'s `first_order`
-    /// module), with its verdict: `Some(true)` where `M` is positive definite, as
+    /// coordinates' rates (not in generalized speeds), in one call, where the model has it as
+    /// one function (a run-time model of up to four degrees of freedom: the equations and the
+    /// solve compiled together, `eomgen_jit`'s `first_order` module), with its verdict: `Some(true)` where `M` is positive definite, as
     /// [`crate::linalg::solve_spd`] tests it (`M₀₀` and `det M` for `n = 2`, the pivots of
     /// `M = L D Lᵀ` otherwise, each positive and not NaN), and every `q̈` is finite;
     /// `Some(false)` otherwise; `None`, writing nothing, where the model has no such function.

@@ -109,7 +109,7 @@ pub(super) fn output_destinations(
 /// The runs `[start, end)` of at least [`ZERO_RUN`] consecutive outputs of one buffer (the
 /// outputs before `split` or those after) that are the constant `+0.0` (a `-0.0` keeps its
 /// own store, its sign bit set).
-pub(super) fn zero_runs(tape: &Tape, split: usize) -> Vec<(usize, usize)> {
+fn zero_runs(tape: &Tape, split: usize) -> Vec<(usize, usize)> {
     let zero = |j: usize| matches!(tape.instructions[tape.outputs[j] as usize], Instruction::Const(c) if c.to_bits() == 0);
     let mut runs = Vec::new();
     for (from, to) in [(0, split), (split, tape.outputs.len())] {
