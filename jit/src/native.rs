@@ -117,7 +117,8 @@ impl std::fmt::Debug for NativeCode {
 
 /// Compiles `functions` (named for errors) into one module, an empty tape getting no code,
 /// and `first_order`, a fused right-hand side of a model of `n` degrees of freedom
-/// ([`FirstOrderFn`]; not compiled if it would need scratch space).
+/// ([`FirstOrderFn`]; not compiled if it would need scratch space, or if its tape is not `2n` values
+/// of `ẏ` then `n` pivots).
 ///
 /// # Errors
 /// [`CompileError`] naming the host or the function Cranelift could not handle.
@@ -132,8 +133,13 @@ pub(crate) fn compile(
         module.target_config().pointer_type(),
     );
     let signature = |layout: Layout| tape_signature(call_conv, pointer, layout);
-    let first_order =
-        first_order.filter(|(f, _)| f.tape.instructions.len() <= SCRATCH_FROM_INSTRUCTIONS);
+    // Its shape checked here, so that `build` may index its pivots: `ẏ` (`2n` values stored),
+    // then the `n` pivots its verdict tests (`crate::first_order`).
+    let first_order = first_order.filter(|(f, n)| {
+        f.tape.instructions.len() <= SCRATCH_FROM_INSTRUCTIONS
+            && f.split == 2 * n
+            && f.tape.outputs.len() == 3 * n
+    });
     let all = functions
         .iter()
         .map(|&(name, f)| (name, f, Layout::Model))
@@ -388,7 +394,6 @@ fn build(
     const _: () = assert!(3 * crate::first_order::FUSED_UP_TO < ZERO_RUN);
     let mut filled = fill_zero_runs(&mut b, module, imports, tape, &outputs);
     if let Layout::FirstOrder { n } = layout {
-        debug_assert_eq!(tape.outputs.len(), 3 * n, "ẏ, then n pivots");
         filled[2 * n..].fill(true);
     }
     let (scratch, slots_used) = match scratch_buffer {
@@ -866,5 +871,49 @@ mod tests {
             )
         };
         assert_eq!(out[0], 9.0);
+    }
+
+    /// A fused right-hand side of `n = 1` is compiled only with its shape, `ẏ` (2 values)
+    /// then one pivot, and its verdict tests the pivot and `q̈`; with a pivot missing it is not
+    /// compiled (no panic), and the model's other functions still are.
+    #[test]
+    fn a_fused_right_hand_side_needs_its_pivots_and_judges_them() {
+        // ẏ = [q̇, q / m], pivot m (parameter 0).
+        let instructions = vec![
+            Instruction::Input(Input::Velocity(0)),
+            Instruction::Input(Input::Coordinate(0)),
+            Instruction::Input(Input::Parameter(0)),
+            Instruction::Div(1, 2),
+        ];
+        let fused = |outputs: Vec<u32>| FunctionTape {
+            tape: Tape {
+                instructions: instructions.clone(),
+                outputs,
+            },
+            split: 2,
+        };
+        let good = tape(vec![Instruction::Input(Input::Coordinate(0))], vec![0]);
+        let whole = fused(vec![0, 3, 2]);
+        let code = compile(&[("kinetic_energy", &good)], Some((&whole, 1))).expect("compiles");
+        let f = code.first_order.expect("the fused function is compiled");
+        let verdict = |m: f64, q: f64| {
+            let (y, mut dy) = ([q, 2.0], [0.0; 2]);
+            // SAFETY: the tape reads one parameter and 2 values of `y`, and writes 2 to `dy`.
+            let verdict = unsafe { f([m].as_ptr(), y.as_ptr(), 0.0, dy.as_mut_ptr()) };
+            (verdict, dy)
+        };
+        assert_eq!(verdict(4.0, 3.0), (1, [2.0, 0.75]));
+        for (m, q) in [
+            (0.0, 3.0),
+            (-1.0, 3.0),
+            (f64::NAN, 3.0),
+            (4.0, f64::INFINITY),
+        ] {
+            assert_eq!(verdict(m, q).0, 0, "m = {m}, q = {q}");
+        }
+        let short = fused(vec![0, 3]);
+        let code = compile(&[("kinetic_energy", &good)], Some((&short, 1))).expect("compiles");
+        assert!(code.first_order.is_none());
+        assert!(code.functions[0].is_some());
     }
 }
