@@ -6,26 +6,34 @@ product.
 
 The orbit is the panel's (tools/panel/kepler_e09.yaml: e = 0.9, mu = 1, 10 periods, from
 x = 0.1, y_dot = sqrt(19)), at tol 1e-6 (order 8) and 1e-9 (order 12). Every code takes the
-same 702 and 715 steps, which the probe checks. The probe writes a standalone Cargo project
-into DIR. It has one binary, with the step in two forms of the same motion:
+same 702 and 715 steps, and ends within 1e-14 of eomgen's x, both of which the probe checks.
+The probe writes a standalone Cargo project into DIR. It has one binary, with the step in
+three forms of the same motion:
 
 * eomgen's: its program for this model (squares of x and y, their sum, the power r2^-1.5 by
-  the recurrence with weights alpha (k - j) - j, the products x r^-3 and y r^-3, negated),
-  the same steps and end state as eomgen's to about 1e-15;
+  the recurrence with weights alpha (k - j) - j, the products x r^-3 and y r^-3, negated);
 * heyoka's (`taylor_adaptive(...).decomposition`): the sum of squares as one convolution,
-  r2^1.5 by the same recurrence, and -x / r^3 and -y / r^3 by the quotient's recurrence.
+  r2^1.5 by the same recurrence, and -x / r^3 and -y / r^3 by the quotient's recurrence;
+* quotient: eomgen's squares, heyoka's r2^1.5 and quotients.
 
-It is built three times: for any x86-64 (SSE2, 16 registers: the rule eomgen keeps, the same
-bits on every processor), for this host (`-C target-cpu=native`: AVX-512's 32 registers
-here), and for this host with products and sums contracted into fused multiply-adds
-(`-C llvm-args=-fp-contract=fast`, as heyoka's LLVM code is: other bits on other processors).
+The probe is a straightforward implementation, not a bound: its order 0 takes r2 sqrt(r2)
+where heyoka calls `pow`, it has no finiteness or branch checks and no driver, and it adds the
+compensated sum heyoka does not make; its sums are serial chains.
 
-Each round runs, in turn, heyoka (`propagate_until`, median of 31), eomgen
-(`work_precision_peers run --from-file on`, the command line's path, median of 31) and the
-six probes (median of 31), the order reversed every other round. It prints ns per step, the
-median over the rounds, and each code's time over heyoka's in the same round (the median of
-those ratios). Usage (from the repository root, with heyoka installed and the crates in
-cargo's cache; offline):
+It is built three times: for any x86-64 (SSE2, 16 registers), for this host
+(`-C target-cpu=native`: AVX-512's 32 registers here; rustc neither contracts nor
+reassociates, so the arithmetic is the same), and for this host with products and sums
+contracted into fused multiply-adds where the compiler chooses (`-C llvm-args=-fp-contract=fast`,
+as heyoka's LLVM code is: other bits than eomgen's, which contracts nothing).
+
+Each round runs, in turn, heyoka twice (`propagate_until`, median of 31: the system written by
+hand, `-x / (x^2 + y^2)^1.5`, and the panel's, heyoka's `lagrangian` of the model file's
+T - V from tools/heyoka_peer.py), eomgen (`work_precision_peers run --from-file on`, the
+command line's path, median of 31) and the nine probes (median of 31), the order reversed
+every other round. It prints ns per step (the median over the rounds), each code's time over
+the hand-written heyoka's in the same round (the median of those ratios) and their spread
+(the largest over the smallest). Usage (from the repository root, with heyoka installed and
+the crates in cargo's cache; offline):
 
     cargo build --release -p eomgen-benches --features work-precision --example work_precision_peers
     python3 tools/taylor_step_probe.py DIR [ROUNDS]
@@ -68,20 +76,23 @@ const W: usize = 16;
 enum Form {
     Eomgen,
     Heyoka,
+    Quotient,
 }
 
 /// Orders 0 ... P of the state (x, y, vx, vy) from its order 0 in `s`.
 #[inline(always)]
 fn series<const P: usize>(form: Form, s: &mut [[f64; W]; 4], reciprocals: &[f64; W]) {
     let (mut r2, mut f, mut ax, mut ay) = ([0.0; W], [0.0; W], [0.0; W], [0.0; W]);
-    // eomgen: f = r2^-1.5; heyoka: f = r2^1.5.
+    // eomgen: f = r2^-1.5; heyoka and quotient: f = r2^1.5.
     let alpha = if form == Form::Eomgen { -1.5 } else { 1.5 };
+    // The two squares apart (eomgen, quotient) or as one sum (heyoka).
+    let apart = form != Form::Heyoka;
     for k in 0..P {
         let (x, y) = (&s[0], &s[1]);
         // Squares as half sums: 2 sum_{j < k/2} a^j a^(k-j) + (a^(k/2))^2 for even k.
         let (mut a, mut b) = (0.0, 0.0);
         for j in 0..(k + 1) / 2 {
-            if form == Form::Eomgen {
+            if apart {
                 a += x[j] * x[k - j];
                 b += y[j] * y[k - j];
             } else {
@@ -91,7 +102,7 @@ fn series<const P: usize>(form: Form, s: &mut [[f64; W]; 4], reciprocals: &[f64;
         a *= 2.0;
         b *= 2.0;
         if k % 2 == 0 {
-            if form == Form::Eomgen {
+            if apart {
                 a += x[k / 2] * x[k / 2];
                 b += y[k / 2] * y[k / 2];
             } else {
@@ -198,6 +209,7 @@ fn run<const P: usize>(form: Form, t_end: f64) -> (usize, f64) {
 fn main() {
     let form = match std::env::args().nth(1).as_deref() {
         Some("heyoka") => Form::Heyoka,
+        Some("quotient") => Form::Quotient,
         _ => Form::Eomgen,
     };
     let t_end = 20.0 * std::f64::consts::PI;
@@ -222,11 +234,17 @@ fn main() {
 HEYOKA = """
 import math, statistics, sys, time
 import heyoka as hy
-x, y, vx, vy = hy.make_vars("x", "y", "vx", "vy")
-r3 = (x**2 + y**2)**1.5
+sys.path.insert(0, sys.argv[2])
+if sys.argv[1] == "hand":
+    x, y, vx, vy = hy.make_vars("x", "y", "vx", "vy")
+    r3 = (x**2 + y**2)**1.5
+    equations = [(x, vx), (y, vy), (vx, -x / r3), (vy, -y / r3)]
+else:
+    import heyoka_peer
+    equations = heyoka_peer.system("kepler_e09", form="lagrangian")[1]
 y0 = [0.1, 0.0, 0.0, math.sqrt(19)]
 for tol in (1e-6, 1e-9):
-    ta = hy.taylor_adaptive([(x, vx), (y, vy), (vx, -x / r3), (vy, -y / r3)], y0, tol=tol)
+    ta = hy.taylor_adaptive(equations, y0, tol=tol)
     times = []
     for _ in range(31):
         ta.state[:] = y0
@@ -277,10 +295,13 @@ def main():
     peers = os.environ.get("EOMGEN_PEERS_BINARY",
                            str(ROOT / "target/release/examples/work_precision_peers"))
     env = dict(os.environ, OPENBLAS_NUM_THREADS="1")
-    codes = {"heyoka": lambda: lines([sys.executable, "-c", HEYOKA], env=env),
+    tools = str(ROOT / "tools")
+    codes = {"heyoka": lambda: lines([sys.executable, "-c", HEYOKA, "hand", tools], env=env),
+             "heyoka, the panel's lagrangian": lambda: lines(
+                 [sys.executable, "-c", HEYOKA, "lagrangian", tools], env=env, cwd=ROOT),
              "eomgen": lambda: eomgen(peers)}
     for name, binary in binaries.items():
-        for form in ("eomgen", "heyoka"):
+        for form in ("eomgen", "quotient", "heyoka"):
             codes[f"one function, {form}'s form, {name}"] = (
                 lambda b=binary, f=form: lines([str(b), f]))
     results = {name: [] for name in codes}
@@ -289,18 +310,26 @@ def main():
         for name, run in order:
             results[name].append(run())
         print(f"round {r + 1}/{rounds}", file=sys.stderr)
-    steps = {tuple(x[0] for x in rows[0]) for rows in results.values()}
+    steps = {tuple(x[0] for x in row) for rows in results.values() for row in rows}
     if len(steps) != 1:
         sys.exit(f"error: the codes took different steps: {steps}")
+    reference = results["eomgen"][0]
+    for name, rows in results.items():
+        for row in rows:
+            for (_, _, x), (_, _, x_ref) in zip(row, reference):
+                if abs(x - x_ref) > 1e-14:
+                    sys.exit(f"error: {name} ends at x = {x!r}, eomgen at {x_ref!r}")
     print(f"Kepler orbit e = 0.9, 10 periods, {steps.pop()} steps at tol 1e-6 and 1e-9; "
           f"{rounds} interleaved rounds, medians")
-    print("| code | ns a step, 1e-6 | 1e-9 | over heyoka's time, 1e-6 | 1e-9 |")
-    print("|---|---|---|---|---|")
+    print("| code | ns a step, 1e-6 | 1e-9 | over heyoka's time, 1e-6 | 1e-9 | spread |")
+    print("|---|---|---|---|---|---|")
     for name, rows in results.items():
         ns = [statistics.median(r[i][1] for r in rows) for i in range(2)]
-        ratio = [statistics.median(r[i][1] / h[i][1] for r, h in zip(rows, results["heyoka"]))
-                 for i in range(2)]
-        print(f"| {name} | {ns[0]:.0f} | {ns[1]:.0f} | {ratio[0]:.2f} | {ratio[1]:.2f} |")
+        ratios = [[r[i][1] / h[i][1] for r, h in zip(rows, results["heyoka"])] for i in range(2)]
+        ratio = [statistics.median(x) for x in ratios]
+        spread = max(max(x) / min(x) for x in ratios)
+        print(f"| {name} | {ns[0]:.0f} | {ns[1]:.0f} | {ratio[0]:.2f} | {ratio[1]:.2f} "
+              f"| {spread:.2f} |")
     for name, rows in results.items():
         print(f"{name}: x(t_end) = {rows[0][0][2]!r}, {rows[0][1][2]!r}", file=sys.stderr)
 
