@@ -371,10 +371,11 @@ pub use eomgen_description::{EventDirection, EventSpec};
 /// over the entries has its sign bit set exactly when an entry is not finite, and only then is
 /// the entry searched for. An AND, an addition and an OR an entry, all on integers, so the
 /// compiler may split the OR over several vector accumulators (four in the build measured):
-/// no chain runs from one entry to the next. (The largest exponent field taken as an `f64` in one vector of four
-/// lanes, as before, was a chain of a comparison and a blend every four entries: about three
-/// quarters of the Taylor series' driver in `perf` on the figure eight at 10⁻⁹, whose 156
-/// coefficients it checks each step; docs/performance.md, "The series' glue".)
+/// no chain runs from one entry to the next. (The largest exponent field taken as an `f64`
+/// in one vector of four lanes, as before, was a chain of a comparison and a blend every
+/// four entries: about three quarters of the Taylor series' driver in `perf` on the figure
+/// eight at 10⁻⁹, whose 156 coefficients it checks each step; docs/performance.md, "Where a
+/// figure-eight step's time goes against heyoka's".)
 #[inline]
 pub(crate) fn first_non_finite(values: &[f64]) -> Option<usize> {
     const EXPONENT: u64 = 0x7ff0_0000_0000_0000;
